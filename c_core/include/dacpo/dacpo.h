@@ -1,0 +1,273 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/**
+ * \file dacpo.h
+ * \brief The public C API of the DACPO normal-orientation core.
+ *
+ * DACPO (TOG 2025, "A Divide-and-Conquer Approach for Global Orientation of
+ * Non-Watertight Scene-Level Point Clouds Using 0-1 Integer Optimization") gives
+ * a point cloud globally consistent normal orientation without a viewpoint:
+ * the cloud is cut into spatially connected blocks, each block is oriented on its
+ * own, and a 0-1 program over the block graph decides which blocks to flip.
+ *
+ * Data crosses this boundary as packed float arrays (3 per point). The core keeps
+ * no caller pointer after a call returns, never prints, exits or aborts, and
+ * reports every failure through a ::dacpo_status plus a message in the context.
+ *
+ * Threads: there is no global mutable state. A context is used by one thread at a
+ * time; with num_threads > 1 a caller-supplied neighbour callback must be
+ * reentrant. Progress callbacks arrive on the calling thread.
+ */
+#ifndef DACPO_DACPO_H
+#define DACPO_DACPO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#define DACPO_API __declspec(dllexport)
+#elif defined(__GNUC__)
+#define DACPO_API __attribute__((visibility("default")))
+#else
+#define DACPO_API
+#endif
+
+#define DACPO_VERSION_MAJOR 0
+#define DACPO_VERSION_MINOR 1
+#define DACPO_VERSION_PATCH 0
+
+/** \brief "MAJOR.MINOR.PATCH" of the library actually linked. */
+DACPO_API const char*
+dacpo_version_string(void);
+
+/** \brief Status codes. Stable: values are never changed or reused. */
+typedef enum dacpo_status {
+  DACPO_OK = 0,
+  DACPO_ERR_INVALID_ARGUMENT = 1, /**< NULL pointer, bad parameter value */
+  DACPO_ERR_EMPTY_INPUT = 2,      /**< count == 0 */
+  DACPO_ERR_NONFINITE_INPUT = 3,  /**< NaN/inf coordinate or normal, zero normal */
+  DACPO_ERR_TOO_FEW_POINTS = 4,   /**< fewer distinct points than the method needs */
+  DACPO_ERR_DISCONNECTED = 5,     /**< k-NN graph disconnected and policy is ERROR */
+  DACPO_ERR_NEIGHBOR_SEARCH = 6,  /**< the neighbour callback failed */
+  DACPO_ERR_SOLVER = 7,           /**< the 0-1 program could not be solved */
+  DACPO_ERR_OUT_OF_MEMORY = 8,
+  DACPO_ERR_CANCELLED = 9, /**< the progress callback asked to stop */
+  DACPO_ERR_INTERNAL = 10
+} dacpo_status;
+
+/** \brief Fixed English text for a status code (never NULL). */
+DACPO_API const char*
+dacpo_status_string(dacpo_status status);
+
+/** \brief Pipeline stages, in the order they run (used for progress and timings). */
+typedef enum dacpo_stage {
+  DACPO_STAGE_INPUT = 0,      /**< validation, duplicate removal */
+  DACPO_STAGE_NEIGHBORS = 1,  /**< k-NN graph, connected components */
+  DACPO_STAGE_NORMALS = 2,    /**< PCA normals (when none were given) */
+  DACPO_STAGE_SEGMENT = 3,    /**< stage 1: block segmentation, block graph */
+  DACPO_STAGE_DIPOLE = 4,     /**< stage 2: dipole-field initialisation per block */
+  DACPO_STAGE_IPSR = 5,       /**< stage 3: iPSR with Neumann Poisson per block */
+  DACPO_STAGE_EDGE_WEIGHTS = 6, /**< stage 4: block-pair consistency weights */
+  DACPO_STAGE_ILP = 7,        /**< stage 5: 0-1 program over the block graph */
+  DACPO_STAGE_COUNT = 8
+} dacpo_stage;
+
+/** \brief Short name of a stage ("segment", "dipole", ...), never NULL. */
+DACPO_API const char*
+dacpo_stage_name(dacpo_stage stage);
+
+/** \brief Which consistency measure weights the block-graph edges. */
+typedef enum dacpo_edge_weight {
+  /** Dipole field (paper Eq. 1) summed over k-NN pairs that cross the boundary. */
+  DACPO_WEIGHT_DIPOLE_BOUNDARY = 0,
+  /** Visible connected regions (paper Sec. 5.1); needs stage 3 meshes. */
+  DACPO_WEIGHT_VCR = 1
+} dacpo_edge_weight;
+
+/** \brief What to do when the k-NN graph has several connected components. */
+typedef enum dacpo_disconnected_policy {
+  /** Orient every component on its own; their relative sign is undefined
+   *  (each component is left with the sign its first block got). */
+  DACPO_DISCONNECTED_SEPARATE = 0,
+  /** Fail with ::DACPO_ERR_DISCONNECTED. */
+  DACPO_DISCONNECTED_ERROR = 1
+} dacpo_disconnected_policy;
+
+/**
+ * \brief Parameters. Always start from dacpo_params_init(); new fields are only
+ * ever appended.
+ */
+typedef struct dacpo_params {
+  size_t k;          /**< k-NN graph size for segmentation/propagation (10) */
+  size_t normal_k;   /**< neighbourhood of PCA normals when estimated (16) */
+  int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
+                             0: use the given normals as axes (default 0) */
+  size_t num_blocks; /**< target number of blocks; 0 = automatic:
+                          n/2500 clamped to [1, 200] (default 0) */
+  size_t ring_hops;  /**< overlap ring width in k-NN hops (3) */
+  double dipole_c;   /**< c of paper Eq. 1: 4 clean, 2 noisy (4.0) */
+  size_t dipole_orders;    /**< M randomized BFS orders (5) */
+  size_t dipole_neighbors; /**< K nearest placed points summed per decision (32) */
+  int dipole_final_sweep;  /**< 1: one re-decision sweep after voting (1) */
+  int ipsr_enabled;        /**< stage 3 on/off (1) */
+  size_t ipsr_max_iterations; /**< (20) */
+  dacpo_edge_weight edge_weight; /**< (DACPO_WEIGHT_DIPOLE_BOUNDARY until VCR lands) */
+  double solver_time_limit; /**< seconds for the 0-1 program (30) */
+  uint64_t seed;            /**< all randomness derives from it (1) */
+  unsigned num_threads;     /**< 0 = all cores (0) */
+  dacpo_disconnected_policy disconnected; /**< (SEPARATE) */
+  size_t min_component_size; /**< components smaller than this are oriented
+                                  as one block without segmentation (1) */
+} dacpo_params;
+
+/** \brief Fill \a params with the defaults documented above. NULL-safe. */
+DACPO_API void
+dacpo_params_init(dacpo_params* params);
+
+/**
+ * \brief Check every field. Returns DACPO_OK or DACPO_ERR_INVALID_ARGUMENT; on
+ * error, if \a message is not NULL, writes a text naming the bad field.
+ */
+DACPO_API dacpo_status
+dacpo_params_validate(const dacpo_params* params, char* message, size_t message_size);
+
+/**
+ * \brief Neighbour search supplied by the caller (e.g. a PCL KdTree).
+ *
+ * Must write up to \a k nearest neighbours of point \a query (an index into the
+ * arrays given to dacpo_orient()) into \a indices (local indices, nearest first,
+ * the query itself may be included) and their squared distances into
+ * \a sq_distances, and the number written into \a found. Return 0 on success; a
+ * non-zero return stops the run with ::DACPO_ERR_NEIGHBOR_SEARCH.
+ */
+typedef int (*dacpo_knn_fn)(void* user,
+                            size_t query,
+                            size_t k,
+                            int32_t* indices,
+                            float* sq_distances,
+                            size_t* found);
+
+/** \brief A neighbour-search callback and its user pointer. */
+typedef struct dacpo_search {
+  dacpo_knn_fn knn;
+  void* user;
+} dacpo_search;
+
+/**
+ * \brief Progress callback: called on the calling thread at stage boundaries and
+ * inside long loops with \a fraction in [0, 1]. Return non-zero to cancel
+ * (the run then returns ::DACPO_ERR_CANCELLED).
+ */
+typedef int (*dacpo_progress_fn)(void* user, dacpo_stage stage, double fraction);
+
+/** \brief A progress callback and its user pointer. */
+typedef struct dacpo_progress {
+  dacpo_progress_fn fn;
+  void* user;
+} dacpo_progress;
+
+/** \brief What the last run did. Valid until the next run or dacpo_ctx_free(). */
+typedef struct dacpo_stats {
+  size_t input_points;     /**< count given */
+  size_t unique_points;    /**< after merging exact duplicates */
+  size_t duplicate_points; /**< input_points - unique_points */
+  size_t k_used;           /**< k after clamping to unique_points - 1 */
+  int k_clamped;           /**< 1 if k was clamped */
+  size_t num_components;   /**< connected components of the k-NN graph */
+  size_t largest_component; /**< points in the largest component */
+  size_t num_blocks;
+  size_t num_block_edges;
+  size_t zero_weight_edges; /**< edges with alpha = alpha-bar = 0 (no information) */
+  size_t flipped_blocks;    /**< blocks the 0-1 program flipped */
+  int solver_optimal;       /**< 1 if every component's 0-1 program was proven optimal */
+  double solver_objective;  /**< sum of omega over edges at the chosen flips */
+  size_t ilp_constraints;   /**< rows given to lp_solve (all components) */
+  size_t ipsr_iterations_total; /**< summed over blocks */
+  size_t ipsr_iterations_max;
+  double stage_seconds[DACPO_STAGE_COUNT]; /**< wall time per stage */
+  double total_seconds;
+  size_t peak_block_points; /**< largest block incl. ring */
+} dacpo_stats;
+
+/** \brief Diagnostics of one block-graph edge. */
+typedef struct dacpo_edge_info {
+  int32_t block_a, block_b; /**< block_a < block_b */
+  double alpha;     /**< consistency with both blocks as they are */
+  double alpha_bar; /**< consistency with one block flipped */
+  double confidence; /**< |alpha - alpha_bar| / (alpha + alpha_bar + eps) in [0,1] */
+} dacpo_edge_info;
+
+/** \brief Opaque context: scratch, last error, stats and per-point results. */
+typedef struct dacpo_ctx dacpo_ctx;
+
+/** \brief Create a context. Returns DACPO_OK, INVALID_ARGUMENT or OUT_OF_MEMORY. */
+DACPO_API dacpo_status
+dacpo_ctx_create(dacpo_ctx** ctx);
+
+/** \brief Free a context and everything it owns. NULL-safe. */
+DACPO_API void
+dacpo_ctx_free(dacpo_ctx* ctx);
+
+/** \brief Message of the last failure ("point 1042 has a NaN coordinate"), or "". */
+DACPO_API const char*
+dacpo_ctx_last_error(const dacpo_ctx* ctx);
+
+/** \brief Stats of the last run (zeroed before the first). NULL if ctx is NULL. */
+DACPO_API const dacpo_stats*
+dacpo_ctx_stats(const dacpo_ctx* ctx);
+
+/**
+ * \brief Per-point results of the last successful run, in input order, each an
+ * array of dacpo_stats.input_points entries owned by the context, or NULL.
+ * - component: connected component id; ids follow the order of each
+ *   component's first input point, so the component of point 0 is 0.
+ * - block: block id of the point.
+ * - curvature: PCA surface variation lambda0/(l0+l1+l2) when normals were
+ *   estimated, else NULL.
+ */
+DACPO_API const int32_t*
+dacpo_ctx_point_components(const dacpo_ctx* ctx);
+DACPO_API const int32_t*
+dacpo_ctx_point_blocks(const dacpo_ctx* ctx);
+DACPO_API const float*
+dacpo_ctx_point_curvature(const dacpo_ctx* ctx);
+
+/** \brief Per-block flip decided by the 0-1 program (num_blocks entries), or NULL. */
+DACPO_API const uint8_t*
+dacpo_ctx_block_flips(const dacpo_ctx* ctx);
+
+/** \brief Block-graph edges with their weights (num_block_edges entries), or NULL. */
+DACPO_API const dacpo_edge_info*
+dacpo_ctx_edges(const dacpo_ctx* ctx);
+
+/**
+ * \brief Orient normals.
+ *
+ * \param[in,out] ctx      context (results are stored there)
+ * \param[in]     params   parameters, NULL = defaults
+ * \param[in]     search   neighbour callback, NULL = built-in kd-tree
+ * \param[in]     progress progress/cancel callback, NULL = none
+ * \param[in]     xyz      3*count floats, finite
+ * \param[in,out] normals  3*count floats. In: normal axes (sign ignored) unless
+ *                         params->estimate_normals; out: oriented unit normals.
+ *                         Left untouched on any error.
+ * \param[in]     count    number of points
+ * \return DACPO_OK, or a status; details in dacpo_ctx_last_error().
+ */
+DACPO_API dacpo_status
+dacpo_orient(dacpo_ctx* ctx,
+             const dacpo_params* params,
+             const dacpo_search* search,
+             const dacpo_progress* progress,
+             const float* xyz,
+             float* normals,
+             size_t count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DACPO_DACPO_H */

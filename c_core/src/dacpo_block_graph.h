@@ -1,0 +1,47 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 4a: the block adjacency graph and the dipole-boundary edge weight. */
+#ifndef DACPO_BLOCK_GRAPH_H
+#define DACPO_BLOCK_GRAPH_H
+
+#include "dacpo_segment.h"
+
+typedef struct dacpo_block_edge {
+  int32_t a, b;     /* a < b */
+  size_t crossing;  /* adjacency pairs joining a and b */
+  double alpha;     /* evidence for "same orientation" as the blocks are */
+  double alpha_bar; /* evidence for "one block flipped" */
+} dacpo_block_edge;
+
+typedef struct dacpo_block_graph {
+  size_t num_edges;
+  dacpo_block_edge* edges; /* sorted by (a, b) */
+} dacpo_block_graph;
+
+/* Blocks a and b are adjacent if an edge of adj joins them. */
+dacpo_status
+dacpo_block_graph_build(const dacpo_blocks* blocks,
+                        const dacpo_adjacency* adj,
+                        dacpo_block_graph* out,
+                        dacpo_err* err);
+
+void
+dacpo_block_graph_free(dacpo_block_graph* g);
+
+/* Dipole-boundary weight: for every adjacency pair (p in a, q in b),
+ * s = e((p,n_p),(q,n_q)) + e((q,n_q),(p,n_p)) with the current oriented normals
+ * (Eq. 2); alpha sums max(s, 0), alpha_bar sums max(-s, 0) (flipping b negates
+ * s, so the two are the evidence for "same" and "differ"). */
+dacpo_status
+dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
+                                 const dacpo_cloud* cloud,
+                                 const dacpo_adjacency* adj,
+                                 const dacpo_blocks* blocks,
+                                 const double* oriented_nrm,
+                                 double c,
+                                 dacpo_err* err);
+
+/* Paper Eq. 7: w_same = alpha/(alpha+alpha_bar+eps), w_diff = alpha_bar/(...). */
+void
+dacpo_edge_omega(double alpha, double alpha_bar, double* w_same, double* w_diff);
+
+#endif

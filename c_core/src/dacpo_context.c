@@ -1,0 +1,311 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Context, error text, status strings, parameter defaults and validation, and
+ * the small utilities every stage uses (RNG, clock, checked allocation). */
+#define _POSIX_C_SOURCE 200809L
+#include "dacpo_context.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+const char*
+dacpo_version_string(void)
+{
+  return "0.1.0";
+}
+
+const char*
+dacpo_status_string(dacpo_status status)
+{
+  switch (status) {
+  case DACPO_OK: return "ok";
+  case DACPO_ERR_INVALID_ARGUMENT: return "invalid argument";
+  case DACPO_ERR_EMPTY_INPUT: return "empty input";
+  case DACPO_ERR_NONFINITE_INPUT: return "non-finite or zero-length input value";
+  case DACPO_ERR_TOO_FEW_POINTS: return "too few distinct points";
+  case DACPO_ERR_DISCONNECTED: return "neighbour graph is disconnected";
+  case DACPO_ERR_NEIGHBOR_SEARCH: return "neighbour search failed";
+  case DACPO_ERR_SOLVER: return "0-1 program solver failed";
+  case DACPO_ERR_OUT_OF_MEMORY: return "out of memory";
+  case DACPO_ERR_CANCELLED: return "cancelled";
+  case DACPO_ERR_INTERNAL: return "internal error";
+  }
+  return "unknown status";
+}
+
+const char*
+dacpo_stage_name(dacpo_stage stage)
+{
+  static const char* const names[DACPO_STAGE_COUNT] = {
+      "input", "neighbors", "normals", "segment",
+      "dipole", "ipsr", "edge_weights", "ilp"};
+  if ((int)stage < 0 || stage >= DACPO_STAGE_COUNT)
+    return "unknown";
+  return names[stage];
+}
+
+void
+dacpo_params_init(dacpo_params* p)
+{
+  if (!p)
+    return;
+  memset(p, 0, sizeof(*p));
+  p->k = 10;
+  p->normal_k = 16;
+  p->estimate_normals = 0;
+  p->num_blocks = 0;
+  p->ring_hops = 3;
+  p->dipole_c = 4.0;
+  p->dipole_orders = 5;
+  p->dipole_neighbors = 32;
+  p->dipole_final_sweep = 1;
+  p->ipsr_enabled = 1;
+  p->ipsr_max_iterations = 20;
+  p->edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
+  p->solver_time_limit = 30.0;
+  p->seed = 1;
+  p->num_threads = 0;
+  p->disconnected = DACPO_DISCONNECTED_SEPARATE;
+  p->min_component_size = 1;
+}
+
+static dacpo_status
+bad_field(char* message, size_t size, const char* fmt, ...)
+{
+  if (message && size > 0) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(message, size, fmt, ap);
+    va_end(ap);
+  }
+  return DACPO_ERR_INVALID_ARGUMENT;
+}
+
+dacpo_status
+dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
+{
+  if (message && size > 0)
+    message[0] = '\0';
+  if (!p)
+    return bad_field(message, size, "params is NULL");
+  if (p->k < 1)
+    return bad_field(message, size, "k must be >= 1 (got %zu)", p->k);
+  if (p->k > 1000)
+    return bad_field(message, size, "k must be <= 1000 (got %zu)", p->k);
+  if (p->estimate_normals && (p->normal_k < 3 || p->normal_k > 1000))
+    return bad_field(message, size, "normal_k must be in [3, 1000] (got %zu)", p->normal_k);
+  if (p->num_blocks > 100000)
+    return bad_field(message, size, "num_blocks must be <= 100000 (got %zu)", p->num_blocks);
+  if (p->ring_hops > 64)
+    return bad_field(message, size, "ring_hops must be <= 64 (got %zu)", p->ring_hops);
+  if (!(p->dipole_c > 1.0) || !isfinite(p->dipole_c))
+    return bad_field(message, size, "dipole_c must be finite and > 1 (paper Eq. 1), got %g",
+                     p->dipole_c);
+  if (p->dipole_orders < 1 || p->dipole_orders > 16)
+    return bad_field(message, size, "dipole_orders must be in [1, 16] (got %zu)",
+                     p->dipole_orders);
+  if (p->dipole_neighbors < 1 || p->dipole_neighbors > 1024)
+    return bad_field(message, size, "dipole_neighbors must be in [1, 1024] (got %zu)",
+                     p->dipole_neighbors);
+  if (p->ipsr_max_iterations > 1000)
+    return bad_field(message, size, "ipsr_max_iterations must be <= 1000 (got %zu)",
+                     p->ipsr_max_iterations);
+  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY && p->edge_weight != DACPO_WEIGHT_VCR)
+    return bad_field(message, size, "edge_weight has an unknown value %d", (int)p->edge_weight);
+  if (!(p->solver_time_limit > 0.0) || !isfinite(p->solver_time_limit))
+    return bad_field(message, size, "solver_time_limit must be finite and > 0 (got %g)",
+                     p->solver_time_limit);
+  if (p->num_threads > 1024)
+    return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
+  if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&
+      p->disconnected != DACPO_DISCONNECTED_ERROR)
+    return bad_field(message, size, "disconnected has an unknown value %d", (int)p->disconnected);
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_err_set(dacpo_err* err, dacpo_status code, const char* fmt, ...)
+{
+  if (err) {
+    err->code = code;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg, sizeof(err->msg), fmt, ap);
+    va_end(ap);
+  }
+  return code;
+}
+
+/* ---- context ----------------------------------------------------------- */
+
+dacpo_status
+dacpo_ctx_create(dacpo_ctx** out)
+{
+  if (!out)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  *out = calloc(1, sizeof(dacpo_ctx));
+  return *out ? DACPO_OK : DACPO_ERR_OUT_OF_MEMORY;
+}
+
+void
+dacpo_ctx_clear_results(dacpo_ctx* ctx)
+{
+  free(ctx->point_component);
+  free(ctx->point_block);
+  free(ctx->point_curvature);
+  free(ctx->block_flips);
+  free(ctx->edges);
+  ctx->point_component = NULL;
+  ctx->point_block = NULL;
+  ctx->point_curvature = NULL;
+  ctx->block_flips = NULL;
+  ctx->edges = NULL;
+  memset(&ctx->stats, 0, sizeof(ctx->stats));
+}
+
+void
+dacpo_ctx_free(dacpo_ctx* ctx)
+{
+  if (!ctx)
+    return;
+  dacpo_ctx_clear_results(ctx);
+  free(ctx);
+}
+
+dacpo_status
+dacpo_ctx_fail(dacpo_ctx* ctx, const dacpo_err* err)
+{
+  snprintf(ctx->last_error, sizeof(ctx->last_error), "%s", err->msg);
+  return err->code;
+}
+
+const char*
+dacpo_ctx_last_error(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->last_error : "context is NULL";
+}
+
+const dacpo_stats*
+dacpo_ctx_stats(const dacpo_ctx* ctx)
+{
+  return ctx ? &ctx->stats : NULL;
+}
+
+const int32_t*
+dacpo_ctx_point_components(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->point_component : NULL;
+}
+
+const int32_t*
+dacpo_ctx_point_blocks(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->point_block : NULL;
+}
+
+const float*
+dacpo_ctx_point_curvature(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->point_curvature : NULL;
+}
+
+const uint8_t*
+dacpo_ctx_block_flips(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->block_flips : NULL;
+}
+
+const dacpo_edge_info*
+dacpo_ctx_edges(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->edges : NULL;
+}
+
+/* ---- utilities --------------------------------------------------------- */
+
+static uint64_t
+splitmix64(uint64_t* x)
+{
+  uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+void
+dacpo_rng_seed(dacpo_rng* rng, uint64_t seed, uint64_t stream)
+{
+  uint64_t x = seed ^ (stream * 0xD1B54A32D192ED03ull);
+  for (int i = 0; i < 4; ++i)
+    rng->s[i] = splitmix64(&x);
+}
+
+static uint64_t
+rotl(uint64_t x, int k)
+{
+  return (x << k) | (x >> (64 - k));
+}
+
+uint64_t
+dacpo_rng_next(dacpo_rng* rng)
+{
+  uint64_t* s = rng->s;
+  const uint64_t result = rotl(s[1] * 5, 7) * 9;
+  const uint64_t t = s[1] << 17;
+  s[2] ^= s[0];
+  s[3] ^= s[1];
+  s[1] ^= s[2];
+  s[0] ^= s[3];
+  s[2] ^= t;
+  s[3] = rotl(s[3], 45);
+  return result;
+}
+
+double
+dacpo_rng_uniform(dacpo_rng* rng)
+{
+  return (double)(dacpo_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+size_t
+dacpo_rng_below(dacpo_rng* rng, size_t n)
+{
+  return (size_t)(dacpo_rng_uniform(rng) * (double)n) % n;
+}
+
+double
+dacpo_now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void
+dacpo_mesh_free(dacpo_mesh* mesh)
+{
+  if (!mesh)
+    return;
+  free(mesh->vertices);
+  free(mesh->triangles);
+  memset(mesh, 0, sizeof(*mesh));
+}
+
+void*
+dacpo_malloc_array(size_t count, size_t size)
+{
+  if (size != 0 && count > SIZE_MAX / size)
+    return NULL;
+  return malloc(count * size ? count * size : 1);
+}
+
+void*
+dacpo_calloc_array(size_t count, size_t size)
+{
+  if (size != 0 && count > SIZE_MAX / size)
+    return NULL;
+  return calloc(count ? count : 1, size ? size : 1);
+}

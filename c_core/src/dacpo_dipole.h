@@ -1,0 +1,35 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 2: dipole-field randomized greedy orientation of one block (paper §4.2,
+ * Eq. 1-4). */
+#ifndef DACPO_DIPOLE_H
+#define DACPO_DIPOLE_H
+
+#include "dacpo_internal.h"
+
+typedef struct dacpo_dipole_params {
+  double c;           /* Eq. 1 constant (4 clean, 2 noisy) */
+  size_t orders;      /* M randomized BFS orders */
+  size_t neighbors;   /* K nearest placed points summed per decision */
+  size_t graph_k;     /* k of the BFS graph */
+  int final_sweep;    /* one re-decision sweep with all neighbours placed */
+  uint64_t seed;
+  uint64_t stream;    /* e.g. the block id: independent of thread count */
+} dacpo_dipole_params;
+
+/* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for
+ * the dipole-boundary edge weight. Returns 0 for |r| below 1e-12 relative. */
+double
+dacpo_dipole_energy(const double p[3], const double n[3], const double q[3], const double m[3], double c);
+
+/* Orients n points (xyz, nrm: 3n, nrm unit axes) of one block: sign_out[i] is
+ * +1 or -1, the block's normals being sign_out[i] * nrm[i]. The overall sign is
+ * arbitrary (the global stage decides it). Builds its own local kd-tree. */
+dacpo_status
+dacpo_dipole_orient(const double* xyz,
+                    const double* nrm,
+                    size_t n,
+                    const dacpo_dipole_params* params,
+                    int8_t* sign_out,
+                    dacpo_err* err);
+
+#endif

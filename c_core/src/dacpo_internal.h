@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Private structures shared by several stages. Nothing here is installed. */
+#ifndef DACPO_INTERNAL_H
+#define DACPO_INTERNAL_H
+
+#include <dacpo/dacpo.h>
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* An error as a stage reports it: stages run on worker threads, so they never
+ * touch the context; the pipeline copies the first error into it. */
+typedef struct dacpo_err {
+  dacpo_status code;
+  char msg[384];
+} dacpo_err;
+
+/* Records code + printf-style message in err (if not NULL); returns code. */
+dacpo_status
+dacpo_err_set(dacpo_err* err, dacpo_status code, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+#define DACPO_CHECK(err, cond, code, ...)                                      \
+  do {                                                                         \
+    if (!(cond))                                                               \
+      return dacpo_err_set((err), (code), __VA_ARGS__);                        \
+  } while (0)
+
+#define DACPO_TRY(expr)                                                        \
+  do {                                                                         \
+    dacpo_status dacpo_try_status_ = (expr);                                   \
+    if (dacpo_try_status_ != DACPO_OK)                                         \
+      return dacpo_try_status_;                                                \
+  } while (0)
+
+#define DACPO_OOM(err) dacpo_err_set((err), DACPO_ERR_OUT_OF_MEMORY, "out of memory in %s", __func__)
+
+/* Small deterministic RNG (splitmix64 seeding + xoshiro256**). Each block gets
+ * its own stream from (seed, block id), so results do not depend on threads. */
+typedef struct dacpo_rng {
+  uint64_t s[4];
+} dacpo_rng;
+
+void
+dacpo_rng_seed(dacpo_rng* rng, uint64_t seed, uint64_t stream);
+uint64_t
+dacpo_rng_next(dacpo_rng* rng);
+/* uniform in [0, 1) */
+double
+dacpo_rng_uniform(dacpo_rng* rng);
+/* uniform integer in [0, n), n > 0 */
+size_t
+dacpo_rng_below(dacpo_rng* rng, size_t n);
+
+/* Wall clock in seconds (monotonic). */
+double
+dacpo_now(void);
+
+/* A triangle mesh. Winding is counter-clockwise seen from the side the
+ * (oriented) normals point to: the face normal (v1-v0)x(v2-v0) agrees with the
+ * block's point normals. */
+typedef struct dacpo_mesh {
+  size_t num_vertices;
+  size_t num_triangles;
+  double* vertices;   /* 3 * num_vertices */
+  int32_t* triangles; /* 3 * num_triangles */
+} dacpo_mesh;
+
+void
+dacpo_mesh_free(dacpo_mesh* mesh); /* frees arrays, zeroes the struct */
+
+/* Checked allocation helpers: return NULL on overflow or failure. */
+void*
+dacpo_malloc_array(size_t count, size_t size);
+void*
+dacpo_calloc_array(size_t count, size_t size);
+
+#endif /* DACPO_INTERNAL_H */

@@ -1,0 +1,44 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 3: iPSR with a Neumann screened Poisson solver, one block at a time
+ * (paper §4.3, ALGORITHM.md §3). */
+#ifndef DACPO_IPSR_H
+#define DACPO_IPSR_H
+
+#include "dacpo_internal.h"
+
+typedef struct dacpo_ipsr_params {
+  size_t max_iterations;  /* 20 */
+  double convergence;     /* 0.1: mean of the largest max(ceil(n/1000),10) |dn| */
+  size_t face_k;          /* 10 nearest samples per face */
+  size_t trim_start;      /* iteration from which wings are trimmed (5) */
+  double trim_spacings;   /* faces farther than this many spacings from the data (2.5) */
+  double point_weight;    /* screening alpha */
+  double cell_per_spacing; /* cell size / median spacing */
+  size_t max_resolution;  /* cap on cells per axis */
+} dacpo_ipsr_params;
+
+void
+dacpo_ipsr_params_default(dacpo_ipsr_params* p);
+
+typedef struct dacpo_ipsr_stats {
+  size_t iterations;
+  size_t resolution;  /* cells per axis used */
+  double seconds;
+  size_t peak_bytes;
+} dacpo_ipsr_stats;
+
+/* Refines the oriented normals nrm (3n, in/out) of a block's n samples; the
+ * first n_own are the block's own points, the rest its ring. If mesh_out is
+ * not NULL it receives the final trimmed mesh restricted to the own points,
+ * wound to agree with the normals. */
+dacpo_status
+dacpo_ipsr_block(const double* xyz,
+                 double* nrm,
+                 size_t n,
+                 size_t n_own,
+                 const dacpo_ipsr_params* params,
+                 dacpo_mesh* mesh_out,
+                 dacpo_ipsr_stats* stats,
+                 dacpo_err* err);
+
+#endif

@@ -1,0 +1,28 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Built-in kd-tree: exact k nearest neighbours in 3-D (used when the caller
+ * gives no search, and inside stages on block-local point sets). */
+#ifndef DACPO_KDTREE_H
+#define DACPO_KDTREE_H
+
+#include "dacpo_internal.h"
+
+typedef struct dacpo_kdtree dacpo_kdtree;
+
+/* Builds over n points (3n doubles, copied). n may be 0. */
+dacpo_status
+dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* err);
+
+void
+dacpo_kdtree_free(dacpo_kdtree* tree);
+
+/* Up to k nearest points of q, nearest first (ties: lower index first); writes
+ * indices and squared distances, returns how many were written (min(k, n)).
+ * Read-only on the tree: safe to call from several threads at once. */
+size_t
+dacpo_kdtree_knn(const dacpo_kdtree* tree,
+                 const double q[3],
+                 size_t k,
+                 int32_t* idx,
+                 double* sq_dist);
+
+#endif

@@ -1,0 +1,22 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 0: PCA normals (paper §4.2, Hoppe 1992) when the caller gives none. */
+#ifndef DACPO_NORMALS_H
+#define DACPO_NORMALS_H
+
+#include "dacpo_knn.h"
+
+/* For each distinct point: the eigenvector of the smallest eigenvalue of the
+ * covariance of the point and its first normal_k neighbours in g (normal_k <=
+ * g->k). Sign is arbitrary. curvature (may be NULL) gets l0/(l0+l1+l2), 0 for
+ * a degenerate neighbourhood. Degenerate (collinear, coincident) neighbourhoods
+ * still give a unit vector, never NaN. */
+dacpo_status
+dacpo_normals_pca(const dacpo_cloud* cloud,
+                  const dacpo_knn_graph* g,
+                  size_t normal_k,
+                  unsigned num_threads,
+                  double* nrm_out,
+                  float* curvature,
+                  dacpo_err* err);
+
+#endif

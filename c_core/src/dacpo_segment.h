@@ -1,0 +1,37 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 1: block segmentation (paper §4.1, ALGORITHM.md §1). */
+#ifndef DACPO_SEGMENT_H
+#define DACPO_SEGMENT_H
+
+#include "dacpo_knn.h"
+
+typedef struct dacpo_blocks {
+  size_t num_blocks;
+  int32_t* block_of;           /* n: block of each distinct point */
+  int32_t* component_of_block; /* num_blocks */
+  size_t* own_start;           /* num_blocks + 1 */
+  int32_t* own;                /* n: points of block b at own[own_start[b] ..], ascending */
+  size_t* ring_start;          /* num_blocks + 1 */
+  int32_t* ring;               /* ring points of block b (owned by other blocks), ascending */
+} dacpo_blocks;
+
+/* Splits each component kd-style (median split on the widest axis) into about
+ * target_blocks * |component| / n subsets of equal count (at least 1), takes the
+ * point nearest each subset's centroid as seed, and grows all blocks at once by
+ * multi-source BFS over adj: every block is connected in adj. The ring of a block
+ * is every point of another block within ring_hops hops of it. Block ids are
+ * numbered component by component. */
+dacpo_status
+dacpo_segment(const dacpo_cloud* cloud,
+              const dacpo_adjacency* adj,
+              const int32_t* component,
+              size_t num_components,
+              size_t target_blocks,
+              size_t ring_hops,
+              dacpo_blocks* out,
+              dacpo_err* err);
+
+void
+dacpo_blocks_free(dacpo_blocks* b);
+
+#endif
