@@ -299,7 +299,8 @@ dacpo_malloc_array(size_t count, size_t size)
 {
   if (size != 0 && count > SIZE_MAX / size)
     return NULL;
-  return malloc(count * size ? count * size : 1);
+  size_t bytes = count * size;
+  return malloc(bytes != 0 ? bytes : 1);
 }
 
 void*

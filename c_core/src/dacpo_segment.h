@@ -31,6 +31,16 @@ dacpo_segment(const dacpo_cloud* cloud,
               dacpo_blocks* out,
               dacpo_err* err);
 
+/* The "no segmentation" ablation: one block per non-empty component (numbered in
+ * component order), own = the component's points, empty rings. */
+dacpo_status
+dacpo_segment_single(const dacpo_cloud* cloud,
+                     const int32_t* component,
+                     size_t num_components,
+                     dacpo_blocks* out,
+                     dacpo_err* err);
+
+/* NULL-safe; frees every array and zeroes the struct. */
 void
 dacpo_blocks_free(dacpo_blocks* b);
 

@@ -187,7 +187,10 @@ typedef struct dacpo_stats {
   size_t ilp_constraints;   /**< rows given to lp_solve (all components) */
   size_t ipsr_iterations_total; /**< summed over blocks */
   size_t ipsr_iterations_max;
-  double stage_seconds[DACPO_STAGE_COUNT]; /**< wall time per stage */
+  /** Wall time per stage. Stages 2 and 3 run in one parallel pass over the
+   *  blocks; its wall time is split between them in proportion to their
+   *  summed per-block times. */
+  double stage_seconds[DACPO_STAGE_COUNT];
   double total_seconds;
   size_t peak_block_points; /**< largest block incl. ring */
 } dacpo_stats;

@@ -1,0 +1,358 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * Stage 2: orientation initialisation of one block by a dipole-like field and a
+ * randomized greedy propagation (paper §4.2, Eq. 1-4; ALGORITHM.md §2).
+ *
+ * Input:  n points of one block (xyz, unit normal axes nrm, 3n doubles each) and
+ *         dacpo_dipole_params (c, M orders, K neighbours, BFS graph k, seed, stream).
+ * Output: sign_out[i] in {+1, -1}; the block's normals are sign_out[i] * nrm[i].
+ *         The overall sign of the block is arbitrary (stage 5 decides it).
+ *
+ * Method: each point's K nearest neighbours (local kd-tree, self excluded) are
+ * listed once together with the pair energies e (Eq. 2) of the unflipped axes.
+ * Since e((p,s n),(q,t m)) = s t e((p,n),(q,m)), every later decision is a signed
+ * sum of these cached numbers. M randomized BFS orders over the (symmetrized)
+ * graph_k-NN graph each give a greedy sign vector (Eq. 4); the M vectors are
+ * aligned by an exhaustive search over relative flips (minimum total Hamming
+ * disagreement) and majority-voted; an optional Gauss-Seidel sweep then lets
+ * every point re-decide with all its K neighbours placed.
+ *
+ * Cost: kd-tree build O(n log n) + n queries of K+1 neighbours, then
+ * O(M n K) for the orders, O(M^2 n + 2^(M-1) M^2) for the alignment, O(n K) for
+ * the sweep. Memory: n K (int32 + double) + O(M n) bytes.
+ *
+ * Failures: INVALID_ARGUMENT (NULL pointers, orders outside [1, 16], neighbors
+ * == 0, n too large for int32 indices), OUT_OF_MEMORY. Non-finite input is the
+ * caller's business (checked in stage 0); near-coincident pairs contribute 0.
+ * Deterministic for a given (seed, stream); no global state, callable from
+ * several threads at once.
+ */
+#include "dacpo_dipole.h"
+
+#include "dacpo_kdtree.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DACPO_DIPOLE_MAX_ORDERS 16
+
+double
+dacpo_dipole_energy(const double p[3],
+                    const double n[3],
+                    const double q[3],
+                    const double m[3],
+                    double c)
+{
+  const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  const double scale = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + q[0] * q[0] +
+                       q[1] * q[1] + q[2] * q[2];
+  /* |r| below 1e-12 of the coordinates' magnitude is a (near) duplicate whose
+   * direction r^ is rounding noise; the absolute floor keeps 1/|r|^3 finite.
+   * Written as !(a > b) so a NaN also gives 0. */
+  if (!(rr > 1e-24 * scale) || rr < 1e-150)
+    return 0.0;
+  const double rn = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
+  const double rm = r[0] * m[0] + r[1] * m[1] + r[2] * m[2];
+  const double nm = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+  /* Eq. 1-2: F.m = -(c (r^.n)(r^.m) - n.m) / |r|^3. Note the value is symmetric
+   * under swapping (p,n) and (q,m): r -> -r leaves (r^.n)(r^.m) unchanged. */
+  return (nm - c * rn * rm / rr) / (rr * sqrt(rr));
+}
+
+/* Everything one call allocates; freed in one place. */
+typedef struct dipole_work {
+  int32_t* nb;      /* n*K nearest neighbours, -1 padded */
+  double* w;        /* n*K e(p_j -> p_i) of the unflipped axes */
+  size_t* gstart;   /* n+1 CSR of the symmetrized graph_k-NN graph */
+  int32_t* gnbr;    /* gstart[n] */
+  int8_t* sign;     /* M*n sign vectors, 0 = not yet placed */
+  uint8_t* visited; /* n */
+  int32_t* queue;   /* n BFS queue = placement order */
+  int32_t* order0;  /* n placement order of order 0 (final sweep) */
+  int32_t* perm;    /* n random permutation: restart points */
+  int32_t* buf;     /* max degree: shuffled neighbour row */
+  int32_t* kbuf;    /* K+1 kd-tree answer */
+  double* kd;       /* K+1 */
+  dacpo_kdtree* tree;
+} dipole_work;
+
+static void
+dipole_work_free(dipole_work* wk)
+{
+  free(wk->nb);
+  free(wk->w);
+  free(wk->gstart);
+  free(wk->gnbr);
+  free(wk->sign);
+  free(wk->visited);
+  free(wk->queue);
+  free(wk->order0);
+  free(wk->perm);
+  free(wk->buf);
+  free(wk->kbuf);
+  free(wk->kd);
+  dacpo_kdtree_free(wk->tree);
+}
+
+/* K nearest of every point (self dropped) and the cached pair energies. */
+static dacpo_status
+dipole_neighbors(const double* xyz,
+                 const double* nrm,
+                 size_t n,
+                 size_t K,
+                 double c,
+                 dipole_work* wk,
+                 dacpo_err* err)
+{
+  DACPO_TRY(dacpo_kdtree_build(xyz, n, &wk->tree, err));
+  wk->nb = dacpo_malloc_array(n * K, sizeof(int32_t));
+  wk->w = dacpo_malloc_array(n * K, sizeof(double));
+  wk->kbuf = dacpo_malloc_array(K + 1, sizeof(int32_t));
+  wk->kd = dacpo_malloc_array(K + 1, sizeof(double));
+  if (!wk->nb || !wk->w || !wk->kbuf || !wk->kd)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t found = dacpo_kdtree_knn(wk->tree, xyz + 3 * i, K + 1, wk->kbuf, wk->kd);
+    int32_t* row = wk->nb + i * K;
+    double* wrow = wk->w + i * K;
+    size_t t = 0;
+    for (size_t f = 0; f < found && t < K; ++f) {
+      const int32_t j = wk->kbuf[f];
+      if (j < 0 || (size_t)j >= n || (size_t)j == i)
+        continue;
+      row[t] = j;
+      /* Eq. 4: the field of the (earlier placed) neighbour j acting on i. */
+      wrow[t] = dacpo_dipole_energy(xyz + 3 * (size_t)j, nrm + 3 * (size_t)j, xyz + 3 * i,
+                                    nrm + 3 * i, c);
+      ++t;
+    }
+    for (; t < K; ++t) {
+      row[t] = -1;
+      wrow[t] = 0.0;
+    }
+  }
+  return DACPO_OK;
+}
+
+/* Symmetrized graph over the first gk entries of each list (repeats allowed: the
+ * BFS skips visited points anyway). */
+static dacpo_status
+dipole_graph(size_t n, size_t K, size_t gk, dipole_work* wk, dacpo_err* err)
+{
+  wk->gstart = dacpo_calloc_array(n + 1, sizeof(size_t));
+  if (!wk->gstart)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t t = 0; t < gk; ++t) {
+      const int32_t j = wk->nb[i * K + t];
+      if (j < 0)
+        continue;
+      wk->gstart[i + 1]++;
+      wk->gstart[(size_t)j + 1]++;
+    }
+  size_t maxdeg = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (wk->gstart[i + 1] > maxdeg)
+      maxdeg = wk->gstart[i + 1];
+    wk->gstart[i + 1] += wk->gstart[i];
+  }
+  wk->gnbr = dacpo_malloc_array(wk->gstart[n], sizeof(int32_t));
+  wk->buf = dacpo_malloc_array(maxdeg, sizeof(int32_t));
+  size_t* fill = dacpo_malloc_array(n, sizeof(size_t));
+  if (!wk->gnbr || !wk->buf || !fill) {
+    free(fill);
+    return DACPO_OOM(err);
+  }
+  memcpy(fill, wk->gstart, n * sizeof(size_t));
+  for (size_t i = 0; i < n; ++i)
+    for (size_t t = 0; t < gk; ++t) {
+      const int32_t j = wk->nb[i * K + t];
+      if (j < 0)
+        continue;
+      wk->gnbr[fill[i]++] = j;
+      wk->gnbr[fill[(size_t)j]++] = (int32_t)i;
+    }
+  free(fill);
+  return DACPO_OK;
+}
+
+/* Greedy sign of point i from its placed neighbours (Eq. 4). A point with no
+ * placed neighbour, or an exact tie, takes +1. */
+static int8_t
+dipole_decide(const dipole_work* wk, size_t K, size_t i, const int8_t* s)
+{
+  const int32_t* row = wk->nb + i * K;
+  const double* wrow = wk->w + i * K;
+  double sum = 0.0;
+  for (size_t t = 0; t < K; ++t) {
+    const int32_t j = row[t];
+    if (j >= 0 && s[j] != 0)
+      sum += (double)s[j] * wrow[t];
+  }
+  return sum >= 0.0 ? 1 : -1;
+}
+
+/* One randomized BFS order; signs placed in s (length n, zeroed here). */
+static void
+dipole_one_order(dipole_work* wk, size_t n, size_t K, dacpo_rng* rng, int8_t* s, int32_t* order_out)
+{
+  memset(s, 0, n);
+  memset(wk->visited, 0, n);
+  /* A random permutation supplies the start point and every restart: scanning it
+   * for the next unvisited point picks a uniformly random unplaced point. */
+  for (size_t i = 0; i < n; ++i)
+    wk->perm[i] = (int32_t)i;
+  for (size_t i = n; i > 1; --i) {
+    const size_t r = dacpo_rng_below(rng, i);
+    const int32_t tmp = wk->perm[i - 1];
+    wk->perm[i - 1] = wk->perm[r];
+    wk->perm[r] = tmp;
+  }
+  size_t head = 0, tail = 0, scan = 0;
+  while (head < n) {
+    if (head == tail) {
+      while (wk->visited[wk->perm[scan]])
+        ++scan;
+      const int32_t start = wk->perm[scan];
+      wk->visited[start] = 1;
+      wk->queue[tail++] = start;
+    }
+    const size_t i = (size_t)wk->queue[head++];
+    s[i] = dipole_decide(wk, K, i, s);
+    /* Visit the neighbours in random order: the orders differ not only by their
+     * start, which is what makes the vote informative. */
+    const size_t b = wk->gstart[i], deg = wk->gstart[i + 1] - b;
+    memcpy(wk->buf, wk->gnbr + b, deg * sizeof(int32_t));
+    for (size_t d = deg; d > 1; --d) {
+      const size_t r = dacpo_rng_below(rng, d);
+      const int32_t tmp = wk->buf[d - 1];
+      wk->buf[d - 1] = wk->buf[r];
+      wk->buf[r] = tmp;
+    }
+    for (size_t d = 0; d < deg; ++d) {
+      const int32_t j = wk->buf[d];
+      if (!wk->visited[j]) {
+        wk->visited[j] = 1;
+        wk->queue[tail++] = j;
+      }
+    }
+  }
+  if (order_out)
+    memcpy(order_out, wk->queue, n * sizeof(int32_t));
+}
+
+/* Relative flips of orders 1..M-1 against order 0 with the least total pairwise
+ * disagreement (paper: exhaustive search over the alignments, M is small). */
+static unsigned
+dipole_align(const int8_t* sign, size_t n, size_t M)
+{
+  size_t diff[DACPO_DIPOLE_MAX_ORDERS][DACPO_DIPOLE_MAX_ORDERS] = {{0}};
+  for (size_t a = 0; a < M; ++a)
+    for (size_t b = a + 1; b < M; ++b) {
+      size_t d = 0;
+      const int8_t* sa = sign + a * n;
+      const int8_t* sb = sign + b * n;
+      for (size_t i = 0; i < n; ++i)
+        d += sa[i] != sb[i];
+      diff[a][b] = d;
+    }
+  unsigned best = 0;
+  size_t best_cost = (size_t)-1;
+  for (unsigned mask = 0; mask < (1u << (M - 1)); ++mask) {
+    const unsigned flip = mask << 1; /* bit m: order m flipped; order 0 fixed */
+    size_t cost = 0;
+    for (size_t a = 0; a < M; ++a)
+      for (size_t b = a + 1; b < M; ++b)
+        cost += (((flip >> a) ^ (flip >> b)) & 1u) ? n - diff[a][b] : diff[a][b];
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = flip;
+    }
+  }
+  return best;
+}
+
+dacpo_status
+dacpo_dipole_orient(const double* xyz,
+                    const double* nrm,
+                    size_t n,
+                    const dacpo_dipole_params* params,
+                    int8_t* sign_out,
+                    dacpo_err* err)
+{
+  DACPO_CHECK(err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
+  if (n == 0)
+    return DACPO_OK;
+  DACPO_CHECK(err, xyz && nrm && sign_out, DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: NULL array for %zu points", n);
+  DACPO_CHECK(err, n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: %zu points exceed int32 indices", n);
+  DACPO_CHECK(err, params->orders >= 1 && params->orders <= DACPO_DIPOLE_MAX_ORDERS,
+              DACPO_ERR_INVALID_ARGUMENT, "dipole: orders must be in [1, %d] (got %zu)",
+              DACPO_DIPOLE_MAX_ORDERS, params->orders);
+  DACPO_CHECK(err, params->neighbors >= 1, DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: neighbors must be >= 1");
+  if (n == 1) {
+    sign_out[0] = 1;
+    return DACPO_OK;
+  }
+  const size_t K = params->neighbors < n - 1 ? params->neighbors : n - 1;
+  const size_t gk = (params->graph_k == 0 || params->graph_k > K) ? K : params->graph_k;
+  const size_t M = params->orders;
+
+  dipole_work wk;
+  memset(&wk, 0, sizeof(wk));
+  dacpo_status st = dipole_neighbors(xyz, nrm, n, K, params->c, &wk, err);
+  if (st == DACPO_OK)
+    st = dipole_graph(n, K, gk, &wk, err);
+  if (st == DACPO_OK) {
+    wk.sign = dacpo_malloc_array(M * n, sizeof(int8_t));
+    wk.visited = dacpo_malloc_array(n, sizeof(uint8_t));
+    wk.queue = dacpo_malloc_array(n, sizeof(int32_t));
+    wk.order0 = dacpo_malloc_array(n, sizeof(int32_t));
+    wk.perm = dacpo_malloc_array(n, sizeof(int32_t));
+    if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm)
+      st = DACPO_OOM(err);
+  }
+  if (st != DACPO_OK) {
+    dipole_work_free(&wk);
+    return st;
+  }
+
+  for (size_t m = 0; m < M; ++m) {
+    dacpo_rng rng;
+    dacpo_rng_seed(&rng, params->seed, params->stream * 1000003u + m);
+    dipole_one_order(&wk, n, K, &rng, wk.sign + m * n, m == 0 ? wk.order0 : NULL);
+  }
+
+  /* Align, then majority vote; a tie keeps order 0's sign. */
+  const unsigned flip = dipole_align(wk.sign, n, M);
+  for (size_t i = 0; i < n; ++i) {
+    int votes = 0;
+    for (size_t m = 0; m < M; ++m)
+      votes += ((flip >> m) & 1u) ? -wk.sign[m * n + i] : wk.sign[m * n + i];
+    sign_out[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk.sign[i];
+  }
+
+  /* Gauss-Seidel sweep in order 0's BFS order: every point now sees all K
+   * neighbours placed; an exact tie keeps the voted sign. */
+  if (params->final_sweep) {
+    for (size_t o = 0; o < n; ++o) {
+      const size_t i = (size_t)wk.order0[o];
+      const int32_t* row = wk.nb + i * K;
+      const double* wrow = wk.w + i * K;
+      double sum = 0.0;
+      for (size_t t = 0; t < K; ++t)
+        if (row[t] >= 0)
+          sum += (double)sign_out[row[t]] * wrow[t];
+      if (sum > 0.0)
+        sign_out[i] = 1;
+      else if (sum < 0.0)
+        sign_out[i] = -1;
+    }
+  }
+  dipole_work_free(&wk);
+  return DACPO_OK;
+}

@@ -1,0 +1,457 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* dacpo_orient(): runs the stages of the paper in order (Fig. 2):
+ *   input (duplicates, checks) -> 0 k-NN graph, components, PCA normals
+ *   -> 1 segmentation into blocks (§4.1) -> 2 dipole initialisation (§4.2)
+ *   -> 3 iPSR with Neumann Poisson (§4.3) -> 4 block-pair weights (§5.1)
+ *   -> 5 0-1 program over the block graph (§5.2) -> flips applied.
+ * Stages 2-3 run per block and stage 4 per edge, in parallel. Only this file
+ * touches the context; stages report through dacpo_err.
+ * Failure modes: every stage's status is passed through unchanged; the caller's
+ * normals are written only after everything succeeded. */
+#include "dacpo_block_graph.h"
+#include "dacpo_context.h"
+#include "dacpo_dipole.h"
+#include "dacpo_ilp.h"
+#include "dacpo_input.h"
+#include "dacpo_ipsr.h"
+#include "dacpo_knn.h"
+#include "dacpo_normals.h"
+#include "dacpo_parallel.h"
+#include "dacpo_segment.h"
+#include "dacpo_vcr.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Blocks smaller than this are too small for a Poisson solve; they keep the
+ * dipole orientation (stage 2). */
+#define DACPO_MIN_IPSR_POINTS 32
+
+typedef struct run_state {
+  dacpo_params p;
+  const dacpo_progress* progress;
+  dacpo_cloud cloud;
+  dacpo_knn_graph knn;
+  dacpo_adjacency adj;
+  int32_t* component;
+  size_t num_components;
+  float* curvature; /* per distinct point, only when estimated */
+  dacpo_blocks blocks;
+  dacpo_block_graph bgraph;
+  double* oriented;        /* 3n: normals after stages 2-3, before flips */
+  dacpo_mesh* meshes;      /* per block, only for VCR weights */
+  dacpo_ipsr_stats* ipsr;  /* per block */
+  double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
+  uint8_t* flips;          /* per block */
+  dacpo_ilp_result ilp;
+} run_state;
+
+static void
+run_state_free(run_state* s)
+{
+  dacpo_cloud_free(&s->cloud);
+  dacpo_knn_graph_free(&s->knn);
+  dacpo_adjacency_free(&s->adj);
+  free(s->component);
+  free(s->curvature);
+  if (s->meshes)
+    for (size_t b = 0; b < s->blocks.num_blocks; ++b)
+      dacpo_mesh_free(&s->meshes[b]);
+  free(s->meshes);
+  dacpo_blocks_free(&s->blocks);
+  dacpo_block_graph_free(&s->bgraph);
+  free(s->oriented);
+  free(s->ipsr);
+  free(s->block_seconds);
+  free(s->flips);
+}
+
+/* Calls the progress callback; non-zero means the caller asked to stop. */
+static dacpo_status
+report(const run_state* s, dacpo_stage stage, double fraction, dacpo_err* err)
+{
+  if (s->progress && s->progress->fn && s->progress->fn(s->progress->user, stage, fraction) != 0)
+    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "cancelled by the progress callback during %s",
+                         dacpo_stage_name(stage));
+  return DACPO_OK;
+}
+
+/* ---- stage 0 ----------------------------------------------------------- */
+
+static dacpo_status
+build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  const size_t min_points = s->p.estimate_normals ? 3 : 2;
+  DACPO_CHECK(err, n >= min_points, DACPO_ERR_TOO_FEW_POINTS,
+              "%zu distinct point(s) among %zu given; at least %zu are needed%s", n,
+              s->cloud.input_count, min_points,
+              s->p.estimate_normals ? " to estimate normals" : "");
+  st->k_used = s->p.k < n - 1 ? s->p.k : n - 1;
+  st->k_clamped = st->k_used != s->p.k;
+  size_t kmax = st->k_used;
+  if (s->p.estimate_normals) {
+    size_t nk = s->p.normal_k < n - 1 ? s->p.normal_k : n - 1;
+    if (nk > kmax)
+      kmax = nk;
+  }
+  DACPO_TRY(dacpo_knn_build(&s->cloud, kmax, search, s->p.num_threads, s->progress, &s->knn, err));
+  DACPO_TRY(dacpo_adjacency_build(&s->knn, st->k_used, &s->adj, err));
+  s->component = dacpo_malloc_array(n, sizeof(int32_t));
+  if (!s->component)
+    return DACPO_OOM(err);
+  DACPO_TRY(dacpo_components_label(&s->adj, s->component, &s->num_components, err));
+
+  size_t* sizes = dacpo_calloc_array(s->num_components, sizeof(size_t));
+  if (!sizes)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < n; ++i)
+    sizes[s->component[i]]++;
+  st->num_components = s->num_components;
+  for (size_t c = 0; c < s->num_components; ++c)
+    if (sizes[c] > st->largest_component)
+      st->largest_component = sizes[c];
+  free(sizes);
+  DACPO_CHECK(err, s->num_components == 1 || s->p.disconnected != DACPO_DISCONNECTED_ERROR,
+              DACPO_ERR_DISCONNECTED,
+              "the k-NN graph (k=%zu) has %zu connected components (largest: %zu of %zu "
+              "points); their relative orientation is undefined",
+              st->k_used, s->num_components, st->largest_component, n);
+  return DACPO_OK;
+}
+
+static dacpo_status
+estimate_normals(run_state* s, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  size_t nk = s->p.normal_k < n - 1 ? s->p.normal_k : n - 1;
+  s->curvature = dacpo_malloc_array(n, sizeof(float));
+  if (!s->curvature)
+    return DACPO_OOM(err);
+  return dacpo_normals_pca(&s->cloud, &s->knn, nk, s->p.num_threads, s->cloud.nrm, s->curvature,
+                           err);
+}
+
+/* ---- stages 2-3: one block at a time ----------------------------------- */
+
+static dacpo_status
+orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
+{
+  run_state* s = user;
+  const dacpo_blocks* bl = &s->blocks;
+  const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
+  const size_t ring0 = bl->ring_start[b], nr = bl->ring_start[b + 1] - ring0;
+  const size_t n = no + nr;
+  double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
+  double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
+  int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
+  dacpo_status st = DACPO_OK;
+  if (!xyz || !nrm || !sign) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  /* own points first, then the ring (ALGORITHM.md §1: the ring gives
+   * continuity to propagation and Poisson but is not part of the output) */
+  for (size_t i = 0; i < n; ++i) {
+    int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
+    memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
+    memcpy(nrm + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
+  }
+  dacpo_dipole_params dp;
+  dp.c = s->p.dipole_c;
+  dp.orders = s->p.dipole_orders;
+  dp.neighbors = s->p.dipole_neighbors;
+  dp.graph_k = s->p.k;
+  dp.final_sweep = s->p.dipole_final_sweep;
+  dp.seed = s->p.seed;
+  dp.stream = (uint64_t)b;
+  double t0 = dacpo_now();
+  st = dacpo_dipole_orient(xyz, nrm, n, &dp, sign, err);
+  double t1 = dacpo_now();
+  s->block_seconds[2 * b] = t1 - t0;
+  if (st != DACPO_OK)
+    goto done;
+  for (size_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      nrm[3 * i + d] *= (double)sign[i];
+
+  if (s->p.ipsr_enabled && n >= DACPO_MIN_IPSR_POINTS) {
+    dacpo_ipsr_params ip;
+    dacpo_ipsr_params_default(&ip);
+    ip.max_iterations = s->p.ipsr_max_iterations;
+    st = dacpo_ipsr_block(xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b],
+                          err);
+    s->block_seconds[2 * b + 1] = dacpo_now() - t1;
+    if (st != DACPO_OK)
+      goto done;
+  }
+  for (size_t i = 0; i < no; ++i)
+    memcpy(s->oriented + 3 * (size_t)bl->own[own0 + i], nrm + 3 * i, 3 * sizeof(double));
+done:
+  (void)thread_id;
+  free(xyz);
+  free(nrm);
+  free(sign);
+  return st;
+}
+
+/* ---- stage 4: VCR weights, one edge at a time -------------------------- */
+
+static dacpo_status
+weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
+{
+  run_state* s = user;
+  dacpo_block_edge* edge = &s->bgraph.edges[e];
+  dacpo_vcr_params vp;
+  dacpo_vcr_params_default(&vp);
+  (void)thread_id;
+  return dacpo_vcr_edge(&s->meshes[edge->a], &s->meshes[edge->b], &vp, &edge->alpha,
+                        &edge->alpha_bar, err);
+}
+
+/* ---- stage 5 ----------------------------------------------------------- */
+
+static dacpo_status
+solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const size_t ne = s->bgraph.num_edges;
+  dacpo_ilp_edge* ie = dacpo_malloc_array(ne, sizeof(dacpo_ilp_edge));
+  s->flips = dacpo_calloc_array(s->blocks.num_blocks, sizeof(uint8_t));
+  if (!ie || !s->flips) {
+    free(ie);
+    return DACPO_OOM(err);
+  }
+  for (size_t e = 0; e < ne; ++e) {
+    const dacpo_block_edge* be = &s->bgraph.edges[e];
+    ie[e].a = be->a;
+    ie[e].b = be->b;
+    dacpo_edge_omega(be->alpha, be->alpha_bar, &ie[e].w_same, &ie[e].w_diff);
+    if (be->alpha == 0.0 && be->alpha_bar == 0.0)
+      st->zero_weight_edges++;
+  }
+  dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks, ne, ie, s->p.solver_time_limit,
+                                   s->progress, s->flips, &s->ilp, err);
+  free(ie);
+  return r;
+}
+
+/* ---- results ----------------------------------------------------------- */
+
+static dacpo_status
+publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
+{
+  const dacpo_cloud* c = &s->cloud;
+  const size_t count = c->input_count;
+  dacpo_stats* st = &ctx->stats;
+  ctx->point_component = dacpo_malloc_array(count, sizeof(int32_t));
+  ctx->point_block = dacpo_malloc_array(count, sizeof(int32_t));
+  ctx->block_flips = dacpo_malloc_array(s->blocks.num_blocks, sizeof(uint8_t));
+  ctx->edges = dacpo_malloc_array(s->bgraph.num_edges, sizeof(dacpo_edge_info));
+  if (s->curvature)
+    ctx->point_curvature = dacpo_malloc_array(count, sizeof(float));
+  if (!ctx->point_component || !ctx->point_block || !ctx->block_flips || !ctx->edges ||
+      (s->curvature && !ctx->point_curvature))
+    return DACPO_OOM(err);
+
+  memcpy(ctx->block_flips, s->flips, s->blocks.num_blocks);
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b)
+    st->flipped_blocks += s->flips[b] != 0;
+  for (size_t e = 0; e < s->bgraph.num_edges; ++e) {
+    const dacpo_block_edge* be = &s->bgraph.edges[e];
+    dacpo_edge_info* info = &ctx->edges[e];
+    info->block_a = be->a;
+    info->block_b = be->b;
+    info->alpha = be->alpha;
+    info->alpha_bar = be->alpha_bar;
+    info->confidence = fabs(be->alpha - be->alpha_bar) / (be->alpha + be->alpha_bar + 1e-12);
+  }
+
+  /* The output keeps each input point's own axis (given or PCA) and only takes
+   * its sign from the refined, flipped block normal: orientation is what DACPO
+   * decides, the axis is the caller's. */
+  for (size_t j = 0; j < count; ++j) {
+    const size_t i = (size_t)c->input_to_point[j];
+    const double flip = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
+    const double* o = s->oriented + 3 * i;
+    double axis[3];
+    if (normals && !s->p.estimate_normals) {
+      double len = sqrt((double)normals[3 * j] * normals[3 * j] +
+                        (double)normals[3 * j + 1] * normals[3 * j + 1] +
+                        (double)normals[3 * j + 2] * normals[3 * j + 2]);
+      for (int d = 0; d < 3; ++d)
+        axis[d] = normals[3 * j + d] / len;
+    }
+    else {
+      memcpy(axis, c->nrm + 3 * i, sizeof(axis));
+    }
+    double dot = axis[0] * o[0] + axis[1] * o[1] + axis[2] * o[2];
+    double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip;
+    for (int d = 0; d < 3; ++d)
+      normals[3 * j + d] = (float)(sign * axis[d]);
+    ctx->point_component[j] = s->component[i];
+    ctx->point_block[j] = s->blocks.block_of[i];
+    if (ctx->point_curvature)
+      ctx->point_curvature[j] = s->curvature[i];
+  }
+  st->solver_optimal = s->ilp.optimal;
+  st->solver_objective = s->ilp.objective;
+  st->ilp_constraints = s->ilp.constraints;
+  return DACPO_OK;
+}
+
+static size_t
+auto_blocks(size_t n)
+{
+  /* ALGORITHM.md §1: about 2.5K points per block, at most the paper's 200. */
+  size_t b = n / 2500;
+  if (b < 1)
+    b = 1;
+  if (b > 200)
+    b = 200;
+  return b;
+}
+
+static dacpo_status
+run(dacpo_ctx* ctx,
+    run_state* s,
+    const dacpo_search* search,
+    const float* xyz,
+    float* normals,
+    size_t count,
+    dacpo_err* err)
+{
+  dacpo_stats* st = &ctx->stats;
+  double t = dacpo_now();
+#define STAGE_DONE(stage)                                                      \
+  do {                                                                         \
+    double now_ = dacpo_now();                                                 \
+    st->stage_seconds[stage] = now_ - t;                                       \
+    t = now_;                                                                  \
+    DACPO_TRY(report(s, (stage), 1.0, err));                                   \
+  } while (0)
+
+  DACPO_TRY(report(s, DACPO_STAGE_INPUT, 0.0, err));
+  DACPO_CHECK(err, normals != NULL, DACPO_ERR_INVALID_ARGUMENT,
+              "normals is NULL: it is the buffer that receives the oriented normals");
+  const float* given = s->p.estimate_normals ? NULL : normals;
+  DACPO_TRY(dacpo_input_check(xyz, given, count, err));
+  DACPO_TRY(dacpo_cloud_build(xyz, given, count, &s->cloud, err));
+  st->input_points = count;
+  st->unique_points = s->cloud.n;
+  st->duplicate_points = count - s->cloud.n;
+  STAGE_DONE(DACPO_STAGE_INPUT);
+
+  DACPO_TRY(build_neighbors(s, st, search, err));
+  STAGE_DONE(DACPO_STAGE_NEIGHBORS);
+
+  if (s->p.estimate_normals)
+    DACPO_TRY(estimate_normals(s, err));
+  STAGE_DONE(DACPO_STAGE_NORMALS);
+
+  size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
+  DACPO_TRY(dacpo_segment(&s->cloud, &s->adj, s->component, s->num_components, target,
+                          s->p.ring_hops, &s->blocks, err));
+  DACPO_TRY(dacpo_block_graph_build(&s->blocks, &s->adj, &s->bgraph, err));
+  st->num_blocks = s->blocks.num_blocks;
+  st->num_block_edges = s->bgraph.num_edges;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    size_t nb = s->blocks.own_start[b + 1] - s->blocks.own_start[b] + s->blocks.ring_start[b + 1] -
+                s->blocks.ring_start[b];
+    if (nb > st->peak_block_points)
+      st->peak_block_points = nb;
+  }
+  STAGE_DONE(DACPO_STAGE_SEGMENT);
+
+  /* Stages 2 and 3 share one pass per block (they are independent per block). */
+  const size_t nb = s->blocks.num_blocks;
+  s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
+  s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
+  s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
+  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR;
+  if (want_meshes)
+    s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
+  if (!s->oriented || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes))
+    return DACPO_OOM(err);
+  DACPO_CHECK(err, !want_meshes || s->p.ipsr_enabled, DACPO_ERR_INVALID_ARGUMENT,
+              "edge_weight VCR needs the stage 3 meshes: enable iPSR or use the "
+              "dipole-boundary weight");
+  DACPO_TRY(dacpo_parallel_for(nb, s->p.num_threads, orient_block, s,
+                               s->progress, s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
+                               err));
+  for (size_t b = 0; b < nb; ++b) {
+    st->ipsr_iterations_total += s->ipsr[b].iterations;
+    if (s->ipsr[b].iterations > st->ipsr_iterations_max)
+      st->ipsr_iterations_max = s->ipsr[b].iterations;
+  }
+  {
+    /* Stages 2 and 3 ran in one parallel pass: split its wall time in
+     * proportion to the summed per-block times of each stage. */
+    double now = dacpo_now(), sum2 = 0.0, sum3 = 0.0;
+    for (size_t b = 0; b < nb; ++b) {
+      sum2 += s->block_seconds[2 * b];
+      sum3 += s->block_seconds[2 * b + 1];
+    }
+    double share2 = sum2 + sum3 > 0.0 ? sum2 / (sum2 + sum3) : 1.0;
+    st->stage_seconds[DACPO_STAGE_DIPOLE] = (now - t) * share2;
+    st->stage_seconds[DACPO_STAGE_IPSR] = (now - t) * (1.0 - share2);
+    t = now;
+  }
+
+  if (want_meshes)
+    DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges, s->p.num_threads, weigh_edge_vcr, s,
+                                 s->progress, DACPO_STAGE_EDGE_WEIGHTS, err));
+  else
+    DACPO_TRY(dacpo_block_graph_dipole_weights(&s->bgraph, &s->cloud, &s->adj, &s->blocks,
+                                               s->oriented, s->p.dipole_c, err));
+  STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
+
+  DACPO_TRY(solve_flips(s, st, err));
+  STAGE_DONE(DACPO_STAGE_ILP);
+
+  DACPO_TRY(publish(ctx, s, normals, err));
+#undef STAGE_DONE
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_orient(dacpo_ctx* ctx,
+             const dacpo_params* params,
+             const dacpo_search* search,
+             const dacpo_progress* progress,
+             const float* xyz,
+             float* normals,
+             size_t count)
+{
+  if (!ctx)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  dacpo_ctx_clear_results(ctx);
+  ctx->last_error[0] = '\0';
+  dacpo_err err = {DACPO_OK, {0}};
+  run_state s;
+  memset(&s, 0, sizeof(s));
+  if (params)
+    s.p = *params;
+  else
+    dacpo_params_init(&s.p);
+  s.progress = progress;
+  char msg[256];
+  if (dacpo_params_validate(&s.p, msg, sizeof(msg)) != DACPO_OK) {
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "%s", msg);
+    return dacpo_ctx_fail(ctx, &err);
+  }
+  const double t0 = dacpo_now();
+  dacpo_status status = run(ctx, &s, search, xyz, normals, count, &err);
+  run_state_free(&s);
+  if (status != DACPO_OK) {
+    if (err.code != status || err.msg[0] == '\0')
+      dacpo_err_set(&err, status, "%s", dacpo_status_string(status));
+    /* keep the stats of the stages that ran, drop partial per-point results */
+    dacpo_stats keep = ctx->stats;
+    dacpo_ctx_clear_results(ctx);
+    ctx->stats = keep;
+    return dacpo_ctx_fail(ctx, &err);
+  }
+  ctx->stats.total_seconds = dacpo_now() - t0;
+  return DACPO_OK;
+}

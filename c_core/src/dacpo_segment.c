@@ -1,0 +1,612 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * Stage 1: block segmentation (paper §4.1, ALGORITHM.md §1).
+ *
+ * The paper cuts the cloud into about 200 spatially connected blocks, each small
+ * enough for the local dipole/iPSR stages and large enough to carry a reliable
+ * orientation. Here:
+ *   1. each connected component c gets B_c = round(B * |c| / n) blocks, clamped to
+ *      [1, max(1, |c| / 8)], so disconnected parts never share a block;
+ *   2. the component's points are split kd-style into B_c subsets of (nearly)
+ *      equal count: median splits on the widest bounding-box axis, a subset that
+ *      must become m blocks is cut in the ratio floor(m/2) : ceil(m/2)
+ *      (quickselect on an index array, O(|c| log B_c));
+ *   3. every subset gives one seed: its point nearest the subset centroid;
+ *   4. one multi-source BFS over the k-NN adjacency, started from all seeds at
+ *      once, gives every point the block whose frontier reaches it first, so each
+ *      block is connected in the graph by construction (O(n + E));
+ *   5. the overlap ring of a block (ALGORITHM.md §1, used by iPSR for continuity)
+ *      is every point of another block within ring_hops hops of it, found by a
+ *      depth-limited BFS per block with a shared visit stamp array (stamp = block
+ *      id), so no n-array is cleared per block: O(E + sum ring * degree).
+ *
+ * Inputs: distinct cloud, symmetric adjacency, component labels.
+ * Outputs: dacpo_blocks (block of each point, CSR of own points and ring points,
+ * component of each block). Block ids are dense, numbered component by
+ * component, within a component in seed order.
+ * Failure modes: NULL or inconsistent arguments (INVALID_ARGUMENT naming the bad
+ * index), allocation failure (OUT_OF_MEMORY). Points the seeded BFS cannot reach
+ * (only if component labels disagree with the adjacency) get blocks of their own
+ * grown the same way, so no point is ever left without a block.
+ * Deterministic: no dependence on threads; quickselect pivots come from a fixed
+ * seed and all keys are made distinct by the point index.
+ */
+#include "dacpo_segment.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------------------
+ * Argument checks
+ * ------------------------------------------------------------------------- */
+
+static dacpo_status
+seg_check_cloud(const dacpo_cloud* cloud,
+                const int32_t* component,
+                size_t num_components,
+                dacpo_blocks* out,
+                dacpo_err* err)
+{
+  DACPO_CHECK(err, cloud != NULL && component != NULL && out != NULL,
+              DACPO_ERR_INVALID_ARGUMENT, "segment: NULL cloud, component or output");
+  DACPO_CHECK(err, cloud->n > 0, DACPO_ERR_EMPTY_INPUT, "segment: the cloud has no points");
+  DACPO_CHECK(err, cloud->n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
+              "segment: %zu points exceed int32 indices", cloud->n);
+  DACPO_CHECK(err, num_components > 0 && num_components <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT, "segment: num_components is %zu", num_components);
+  for (size_t i = 0; i < cloud->n; ++i)
+    DACPO_CHECK(err, component[i] >= 0 && (size_t)component[i] < num_components,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "segment: point %zu has component %ld, outside [0, %zu)", i,
+                (long)component[i], num_components);
+  return DACPO_OK;
+}
+
+static dacpo_status
+seg_check_adjacency(const dacpo_adjacency* adj, size_t n, dacpo_err* err)
+{
+  DACPO_CHECK(err, adj != NULL && adj->start != NULL, DACPO_ERR_INVALID_ARGUMENT,
+              "segment: NULL adjacency");
+  DACPO_CHECK(err, adj->n == n, DACPO_ERR_INVALID_ARGUMENT,
+              "segment: adjacency has %zu points, cloud has %zu", adj->n, n);
+  DACPO_CHECK(err, adj->start[0] == 0 && (adj->start[n] == 0 || adj->nbr != NULL),
+              DACPO_ERR_INVALID_ARGUMENT, "segment: malformed adjacency arrays");
+  for (size_t i = 0; i < n; ++i) {
+    DACPO_CHECK(err, adj->start[i] <= adj->start[i + 1], DACPO_ERR_INVALID_ARGUMENT,
+                "segment: adjacency row %zu has a decreasing start", i);
+    for (size_t e = adj->start[i]; e < adj->start[i + 1]; ++e)
+      DACPO_CHECK(err, adj->nbr[e] >= 0 && (size_t)adj->nbr[e] < n,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "segment: adjacency row %zu lists point %ld, outside [0, %zu)", i,
+                  (long)adj->nbr[e], n);
+  }
+  return DACPO_OK;
+}
+
+/* ---------------------------------------------------------------------------
+ * kd-style split into equal-count subsets, one seed per subset
+ * ------------------------------------------------------------------------- */
+
+typedef struct seg_splitter {
+  const double* xyz;
+  int32_t* idx;   /* working permutation of the component's points */
+  int32_t* seeds; /* output, in recursion (left first) order */
+  size_t num_seeds;
+  dacpo_rng rng;  /* quickselect pivots only; fixed seed, so deterministic */
+} seg_splitter;
+
+/* Strict order on (coordinate, index): all keys distinct, so quickselect never
+ * degrades on ties (grids have many equal coordinates). */
+static int
+seg_less(const double* xyz, int axis, int32_t a, int32_t b)
+{
+  double xa = xyz[3 * (size_t)a + (size_t)axis];
+  double xb = xyz[3 * (size_t)b + (size_t)axis];
+  return xa < xb || (xa == xb && a < b);
+}
+
+/* Rearranges idx[lo, hi) so that idx[lo, kth) are the kth - lo smallest keys.
+ * Random pivot: expected O(hi - lo). */
+static void
+seg_select(seg_splitter* s, size_t lo, size_t hi, size_t kth, int axis)
+{
+  int32_t* idx = s->idx;
+  while (hi - lo > 1) {
+    size_t p = lo + dacpo_rng_below(&s->rng, hi - lo);
+    int32_t t = idx[p];
+    idx[p] = idx[hi - 1];
+    idx[hi - 1] = t;
+    int32_t pivot = idx[hi - 1];
+    size_t store = lo;
+    for (size_t i = lo; i + 1 < hi; ++i) {
+      if (seg_less(s->xyz, axis, idx[i], pivot)) {
+        t = idx[i];
+        idx[i] = idx[store];
+        idx[store] = t;
+        ++store;
+      }
+    }
+    idx[hi - 1] = idx[store];
+    idx[store] = pivot;
+    if (store == kth)
+      return;
+    if (kth < store)
+      hi = store;
+    else
+      lo = store + 1;
+  }
+}
+
+/* The seed of a subset: its point nearest the centroid (ties: lower index), a
+ * point well inside the subset so the BFS fronts start evenly spread. */
+static int32_t
+seg_seed(const seg_splitter* s, size_t lo, size_t hi)
+{
+  double c[3] = {0.0, 0.0, 0.0};
+  for (size_t i = lo; i < hi; ++i)
+    for (int a = 0; a < 3; ++a)
+      c[a] += s->xyz[3 * (size_t)s->idx[i] + (size_t)a];
+  for (int a = 0; a < 3; ++a)
+    c[a] /= (double)(hi - lo);
+  int32_t best = -1;
+  double best_d = INFINITY;
+  for (size_t i = lo; i < hi; ++i) {
+    const double* p = s->xyz + 3 * (size_t)s->idx[i];
+    double d = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+               (p[2] - c[2]) * (p[2] - c[2]);
+    if (best < 0 || d < best_d || (d == best_d && s->idx[i] < best)) {
+      best = s->idx[i];
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+/* Splits idx[lo, hi) into m subsets of nearly equal count and appends one seed
+ * per subset. Requires hi - lo >= m >= 1. Recursion depth is log2(m). */
+static void
+seg_split(seg_splitter* s, size_t lo, size_t hi, size_t m)
+{
+  if (m <= 1) {
+    s->seeds[s->num_seeds++] = seg_seed(s, lo, hi);
+    return;
+  }
+  double mn[3] = {INFINITY, INFINITY, INFINITY};
+  double mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = lo; i < hi; ++i) {
+    const double* p = s->xyz + 3 * (size_t)s->idx[i];
+    for (int a = 0; a < 3; ++a) {
+      if (p[a] < mn[a])
+        mn[a] = p[a];
+      if (p[a] > mx[a])
+        mx[a] = p[a];
+    }
+  }
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (mx[a] - mn[a] > mx[axis] - mn[axis])
+      axis = a;
+  size_t cnt = hi - lo;
+  size_t m1 = m / 2, m2 = m - m1;
+  /* counts in the ratio of the block counts, so every final subset has ~cnt/m */
+  size_t k = (size_t)floor((double)cnt * (double)m1 / (double)m + 0.5);
+  if (k < m1)
+    k = m1;
+  if (k > cnt - m2)
+    k = cnt - m2;
+  seg_select(s, lo, hi, lo + k, axis);
+  seg_split(s, lo, lo + k, m1);
+  seg_split(s, lo + k, hi, m2);
+}
+
+/* ---------------------------------------------------------------------------
+ * Output assembly shared by dacpo_segment and dacpo_segment_single
+ * ------------------------------------------------------------------------- */
+
+/* own/own_start from block_of (counting sort over ascending points, so every
+ * block's list is ascending). */
+static dacpo_status
+seg_build_own(size_t n, dacpo_blocks* b, dacpo_err* err)
+{
+  b->own_start = (size_t*)dacpo_calloc_array(b->num_blocks + 1, sizeof(size_t));
+  b->own = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  if (b->own_start == NULL || b->own == NULL)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < n; ++i)
+    b->own_start[(size_t)b->block_of[i] + 1]++;
+  for (size_t k = 0; k < b->num_blocks; ++k)
+    b->own_start[k + 1] += b->own_start[k];
+  size_t* cur = (size_t*)dacpo_malloc_array(b->num_blocks, sizeof(size_t));
+  if (cur == NULL)
+    return DACPO_OOM(err);
+  memcpy(cur, b->own_start, b->num_blocks * sizeof(size_t));
+  for (size_t i = 0; i < n; ++i)
+    b->own[cur[b->block_of[i]]++] = (int32_t)i;
+  free(cur);
+  return DACPO_OK;
+}
+
+static int
+seg_cmp_i32(const void* a, const void* b)
+{
+  int32_t x = *(const int32_t*)a, y = *(const int32_t*)b;
+  return (x > y) - (x < y);
+}
+
+/* Rings: depth-limited BFS from each block's own points into other blocks of the
+ * same component. stamp[p] == b marks p as seen for block b; block ids are
+ * distinct, so the array is never cleared. The BFS queue only ever holds ring
+ * points (the own points are layer 0, read from own[]). */
+static dacpo_status
+seg_build_rings(const dacpo_adjacency* adj,
+                const int32_t* component,
+                size_t ring_hops,
+                dacpo_blocks* b,
+                dacpo_err* err)
+{
+  size_t n = adj->n;
+  dacpo_status st = DACPO_OK;
+  int32_t* stamp = NULL;
+  int32_t* queue = NULL;
+  size_t cap = 0, len = 0;
+
+  b->ring_start = (size_t*)dacpo_calloc_array(b->num_blocks + 1, sizeof(size_t));
+  if (b->ring_start == NULL)
+    return DACPO_OOM(err);
+  if (ring_hops == 0) {
+    b->ring = (int32_t*)dacpo_malloc_array(0, sizeof(int32_t));
+    return b->ring == NULL ? DACPO_OOM(err) : DACPO_OK;
+  }
+
+  stamp = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  queue = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  cap = n / 4 + 64;
+  b->ring = (int32_t*)dacpo_malloc_array(cap, sizeof(int32_t));
+  if (stamp == NULL || queue == NULL || b->ring == NULL) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  for (size_t i = 0; i < n; ++i)
+    stamp[i] = -1;
+
+  for (size_t blk = 0; blk < b->num_blocks; ++blk) {
+    const int32_t tag = (int32_t)blk;
+    const int32_t comp = b->component_of_block[blk];
+    const int32_t* own = b->own + b->own_start[blk];
+    const size_t num_own = b->own_start[blk + 1] - b->own_start[blk];
+    for (size_t i = 0; i < num_own; ++i)
+      stamp[own[i]] = tag;
+    size_t qlen = 0;
+    size_t layer_lo = 0, layer_hi = 0; /* queue range of the previous layer */
+    for (size_t hop = 1; hop <= ring_hops; ++hop) {
+      const int32_t* src = hop == 1 ? own : queue + layer_lo;
+      size_t num_src = hop == 1 ? num_own : layer_hi - layer_lo;
+      if (num_src == 0)
+        break;
+      for (size_t i = 0; i < num_src; ++i) {
+        int32_t p = src[i];
+        for (size_t e = adj->start[p]; e < adj->start[p + 1]; ++e) {
+          int32_t q = adj->nbr[e];
+          if (stamp[q] != tag && component[q] == comp) {
+            stamp[q] = tag;
+            queue[qlen++] = q;
+          }
+        }
+      }
+      layer_lo = hop == 1 ? 0 : layer_hi;
+      layer_hi = qlen;
+    }
+    qsort(queue, qlen, sizeof(int32_t), seg_cmp_i32);
+    if (qlen > cap - len) {
+      size_t need = len + qlen;
+      size_t new_cap = cap > SIZE_MAX / 2 ? need : cap * 2;
+      if (new_cap < need)
+        new_cap = need;
+      int32_t* grown = new_cap > SIZE_MAX / sizeof(int32_t)
+                           ? NULL
+                           : (int32_t*)realloc(b->ring, new_cap * sizeof(int32_t));
+      if (grown == NULL) {
+        st = DACPO_OOM(err);
+        goto done;
+      }
+      b->ring = grown;
+      cap = new_cap;
+    }
+    memcpy(b->ring + len, queue, qlen * sizeof(int32_t));
+    len += qlen;
+    b->ring_start[blk + 1] = len;
+  }
+
+done:
+  free(stamp);
+  free(queue);
+  return st;
+}
+
+/* ---------------------------------------------------------------------------
+ * Block growing
+ * ------------------------------------------------------------------------- */
+
+/* Multi-source BFS from queue[0, qlen) (already labelled), restricted to each
+ * source's component; points take the label of the first front reaching them.
+ * Returns the new queue length. */
+static size_t
+seg_grow(const dacpo_adjacency* adj,
+         const int32_t* component,
+         int32_t* label,
+         int32_t* queue,
+         size_t head,
+         size_t qlen)
+{
+  while (head < qlen) {
+    int32_t p = queue[head++];
+    for (size_t e = adj->start[p]; e < adj->start[p + 1]; ++e) {
+      int32_t q = adj->nbr[e];
+      if (label[q] < 0 && component[q] == component[p]) {
+        label[q] = label[p];
+        queue[qlen++] = q;
+      }
+    }
+  }
+  return qlen;
+}
+
+dacpo_status
+dacpo_segment(const dacpo_cloud* cloud,
+              const dacpo_adjacency* adj,
+              const int32_t* component,
+              size_t num_components,
+              size_t target_blocks,
+              size_t ring_hops,
+              dacpo_blocks* out,
+              dacpo_err* err)
+{
+  if (out != NULL)
+    memset(out, 0, sizeof(*out));
+  DACPO_TRY(seg_check_cloud(cloud, component, num_components, out, err));
+  const size_t n = cloud->n;
+  DACPO_TRY(seg_check_adjacency(adj, n, err));
+  DACPO_CHECK(err, cloud->xyz != NULL, DACPO_ERR_INVALID_ARGUMENT,
+              "segment: cloud has no coordinates");
+
+  dacpo_status st = DACPO_OK;
+  dacpo_blocks res;
+  memset(&res, 0, sizeof(res));
+  size_t* comp_start = NULL;  /* num_components + 1 */
+  size_t* nblk = NULL;        /* blocks wanted per component */
+  seg_splitter sp;
+  memset(&sp, 0, sizeof(sp));
+  int32_t* raw_comp = NULL;   /* component of each raw (pre-renumbering) block */
+  int32_t* queue = NULL;
+  size_t* raw_size = NULL;
+  int32_t* remap = NULL;
+
+  comp_start = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
+  nblk = (size_t*)dacpo_calloc_array(num_components, sizeof(size_t));
+  sp.idx = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  if (comp_start == NULL || nblk == NULL || sp.idx == NULL) {
+    st = DACPO_OOM(err);
+    goto fail;
+  }
+
+  /* Points grouped by component (counting sort, ascending inside a component). */
+  for (size_t i = 0; i < n; ++i)
+    comp_start[(size_t)component[i] + 1]++;
+  for (size_t c = 0; c < num_components; ++c)
+    comp_start[c + 1] += comp_start[c];
+  {
+    size_t* cur = (size_t*)dacpo_malloc_array(num_components, sizeof(size_t));
+    if (cur == NULL) {
+      st = DACPO_OOM(err);
+      goto fail;
+    }
+    memcpy(cur, comp_start, num_components * sizeof(size_t));
+    for (size_t i = 0; i < n; ++i)
+      sp.idx[cur[component[i]]++] = (int32_t)i;
+    free(cur);
+  }
+
+  /* Blocks per component: proportional to its size, at least 1, at most |c|/8
+   * (blocks of a handful of points carry no reliable orientation). */
+  size_t total = 0;
+  for (size_t c = 0; c < num_components; ++c) {
+    size_t sz = comp_start[c + 1] - comp_start[c];
+    if (sz == 0)
+      continue;
+    size_t want = 1;
+    if (target_blocks > 0) {
+      double w = floor((double)target_blocks * (double)sz / (double)n + 0.5);
+      want = w < 1.0 ? 1 : (w > (double)sz ? sz : (size_t)w);
+    }
+    size_t cap = sz / 8 > 0 ? sz / 8 : 1;
+    if (want > cap)
+      want = cap;
+    nblk[c] = want;
+    total += want;
+  }
+
+  /* Seeds, component by component. Unreached points (see below) may add at most
+   * n - total further blocks, so n slots are enough for all raw blocks. */
+  sp.xyz = cloud->xyz;
+  sp.seeds = (int32_t*)dacpo_malloc_array(total, sizeof(int32_t));
+  raw_comp = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  res.block_of = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  queue = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  if (sp.seeds == NULL || raw_comp == NULL || res.block_of == NULL || queue == NULL) {
+    st = DACPO_OOM(err);
+    goto fail;
+  }
+  dacpo_rng_seed(&sp.rng, 0x5e9d0b10c5ULL, 1);
+  for (size_t c = 0; c < num_components; ++c) {
+    if (nblk[c] == 0)
+      continue;
+    size_t first = sp.num_seeds;
+    seg_split(&sp, comp_start[c], comp_start[c + 1], nblk[c]);
+    for (size_t s = first; s < sp.num_seeds; ++s)
+      raw_comp[s] = (int32_t)c;
+  }
+  if (sp.num_seeds != total) {
+    st = dacpo_err_set(err, DACPO_ERR_INTERNAL,
+                       "segment: kd split produced %zu seeds, expected %zu",
+                       sp.num_seeds, total);
+    goto fail;
+  }
+
+  /* Grow all blocks at once: the queue starts with every seed in block order. */
+  for (size_t i = 0; i < n; ++i)
+    res.block_of[i] = -1;
+  for (size_t s = 0; s < total; ++s) {
+    res.block_of[sp.seeds[s]] = (int32_t)s;
+    queue[s] = sp.seeds[s];
+  }
+  size_t qlen = seg_grow(adj, component, res.block_of, queue, 0, total);
+
+  /* A point no seed reached means its labelled component is not connected in
+   * adj. Give each such piece its own block, grown the same way, so every block
+   * stays connected and no point is left unlabelled. */
+  size_t num_raw = total;
+  if (qlen < n) {
+    for (size_t i = 0; i < n; ++i) {
+      if (res.block_of[i] >= 0)
+        continue;
+      res.block_of[i] = (int32_t)num_raw;
+      raw_comp[num_raw] = component[i];
+      ++num_raw;
+      size_t head = qlen;
+      queue[qlen++] = (int32_t)i;
+      qlen = seg_grow(adj, component, res.block_of, queue, head, qlen);
+    }
+  }
+
+  /* Dense ids, component by component, seed order inside; empty blocks dropped
+   * (a seed always owns itself, so none is expected). */
+  raw_size = (size_t*)dacpo_calloc_array(num_raw, sizeof(size_t));
+  remap = (int32_t*)dacpo_malloc_array(num_raw, sizeof(int32_t));
+  if (raw_size == NULL || remap == NULL) {
+    st = DACPO_OOM(err);
+    goto fail;
+  }
+  for (size_t i = 0; i < n; ++i)
+    raw_size[res.block_of[i]]++;
+  {
+    /* raw blocks are already grouped by component except the extra ones, which
+     * come after all seeded blocks: a stable counting pass per component */
+    size_t* per_comp = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
+    if (per_comp == NULL) {
+      st = DACPO_OOM(err);
+      goto fail;
+    }
+    for (size_t r = 0; r < num_raw; ++r)
+      if (raw_size[r] > 0)
+        per_comp[(size_t)raw_comp[r] + 1]++;
+    for (size_t c = 0; c < num_components; ++c)
+      per_comp[c + 1] += per_comp[c];
+    res.num_blocks = per_comp[num_components];
+    res.component_of_block = (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
+    if (res.component_of_block == NULL) {
+      free(per_comp);
+      st = DACPO_OOM(err);
+      goto fail;
+    }
+    for (size_t r = 0; r < num_raw; ++r) {
+      if (raw_size[r] == 0) {
+        remap[r] = -1;
+        continue;
+      }
+      size_t id = per_comp[raw_comp[r]]++;
+      remap[r] = (int32_t)id;
+      res.component_of_block[id] = raw_comp[r];
+    }
+    free(per_comp);
+  }
+  for (size_t i = 0; i < n; ++i)
+    res.block_of[i] = remap[res.block_of[i]];
+
+  if ((st = seg_build_own(n, &res, err)) != DACPO_OK)
+    goto fail;
+  if ((st = seg_build_rings(adj, component, ring_hops, &res, err)) != DACPO_OK)
+    goto fail;
+
+  *out = res;
+  goto done;
+
+fail:
+  dacpo_blocks_free(&res);
+done:
+  free(comp_start);
+  free(nblk);
+  free(sp.idx);
+  free(sp.seeds);
+  free(raw_comp);
+  free(queue);
+  free(raw_size);
+  free(remap);
+  return st;
+}
+
+dacpo_status
+dacpo_segment_single(const dacpo_cloud* cloud,
+                     const int32_t* component,
+                     size_t num_components,
+                     dacpo_blocks* out,
+                     dacpo_err* err)
+{
+  if (out != NULL)
+    memset(out, 0, sizeof(*out));
+  DACPO_TRY(seg_check_cloud(cloud, component, num_components, out, err));
+  const size_t n = cloud->n;
+  dacpo_status st = DACPO_OK;
+  dacpo_blocks res;
+  memset(&res, 0, sizeof(res));
+  int32_t* comp_block = (int32_t*)dacpo_malloc_array(num_components, sizeof(int32_t));
+  res.block_of = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  if (comp_block == NULL || res.block_of == NULL) {
+    st = DACPO_OOM(err);
+    goto fail;
+  }
+  /* Components without points get no block; the others are numbered in order. */
+  for (size_t c = 0; c < num_components; ++c)
+    comp_block[c] = -1;
+  for (size_t i = 0; i < n; ++i)
+    comp_block[component[i]] = 0;
+  for (size_t c = 0; c < num_components; ++c)
+    if (comp_block[c] == 0)
+      comp_block[c] = (int32_t)res.num_blocks++;
+  res.component_of_block = (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
+  res.ring_start = (size_t*)dacpo_calloc_array(res.num_blocks + 1, sizeof(size_t));
+  res.ring = (int32_t*)dacpo_malloc_array(0, sizeof(int32_t));
+  if (res.component_of_block == NULL || res.ring_start == NULL || res.ring == NULL) {
+    st = DACPO_OOM(err);
+    goto fail;
+  }
+  for (size_t c = 0; c < num_components; ++c)
+    if (comp_block[c] >= 0)
+      res.component_of_block[comp_block[c]] = (int32_t)c;
+  for (size_t i = 0; i < n; ++i)
+    res.block_of[i] = comp_block[component[i]];
+  if ((st = seg_build_own(n, &res, err)) != DACPO_OK)
+    goto fail;
+  *out = res;
+  free(comp_block);
+  return DACPO_OK;
+
+fail:
+  dacpo_blocks_free(&res);
+  free(comp_block);
+  return st;
+}
+
+void
+dacpo_blocks_free(dacpo_blocks* b)
+{
+  if (b == NULL)
+    return;
+  free(b->block_of);
+  free(b->component_of_block);
+  free(b->own_start);
+  free(b->own);
+  free(b->ring_start);
+  free(b->ring);
+  memset(b, 0, sizeof(*b));
+}
