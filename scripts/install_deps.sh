@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs the Debian packages pcl_dacpo needs to build, test and run.
+# Idempotent: does nothing when everything is already installed.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  libpcl-dev          # PCL 1.13 (pulls FLANN, Eigen, Boost, VTK)
+  liblpsolve55-dev    # lp_solve headers
+  lp-solve            # lp_solve shared library (/usr/lib/lp_solve/liblpsolve55.so, LGPL)
+  libgtest-dev        # gtest
+  pcl-tools           # pcl_viewer for looking at results
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install_deps: installing ${missing[*]}"
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -q
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${missing[@]}"

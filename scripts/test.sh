@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Installs dependencies, builds, and runs the whole test suite with ctest.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${DACPO_BUILD_DIR:-$root/build}"
+"$root/scripts/build.sh" "$@"
+cd "$build"
+ctest --output-on-failure -j "$(nproc)"

@@ -1,0 +1,171 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/**
+ * \file dacpo_scene.h
+ * \brief Synthetic scenes with ground-truth normals, random sign scrambling and
+ *        the paper's orientation score. Used by tests, samples, the demo and the
+ *        benchmarks; pure C11, independent of the core's private headers.
+ *
+ * A scene is a list of analytic surface patches (rectangles with rectangular
+ * holes, cylinder patches, annuli, spheres). Points are drawn uniformly by area,
+ * the total is exactly `target_points`; ground-truth normals are unit vectors
+ * pointing into free space (into the room for walls and floor, out of the solid
+ * for both faces of thin objects). Optional Gaussian noise (paper section 6:
+ * displacement sigma * N(0,1) along a uniformly random direction; normals keep
+ * the ground truth) and optional random downsampling (order preserved).
+ *
+ * Everything is deterministic per seed and free of global state, so it can be
+ * called from several threads at once. Nothing here prints, exits or aborts;
+ * failures return non-zero and write a message to `err`.
+ *
+ * Coordinates are metres, z is up.
+ */
+#ifndef DACPO_SCENE_H
+#define DACPO_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** \brief Scene kinds (values are stable). */
+typedef enum dacpo_scene_kind {
+  /** Open ScanNet-like room, 6 x 5 x 2.6 m: floor and the inner faces of four walls
+   *  (door opening in the y = 0 wall, no ceiling) with a table (4 cm top on four
+   *  open-cylinder legs), two chairs (3 cm seats, 2 cm backrests, box legs), a
+   *  bookshelf of 2 cm boards, a thick-walled open bin (both faces and rim), a
+   *  free-standing 10 cm partition wall, a thin 2 cm screen on legs and a cabinet
+   *  against a wall. The default scene. */
+  DACPO_SCENE_ROOM = 0,
+  /** 2 x 2 m square in z = 0, x, y in [-1, 1], normal +z. One part. */
+  DACPO_SCENE_PLANE = 1,
+  /** Closed unit sphere at the origin, normals outward. One part. */
+  DACPO_SCENE_SPHERE = 2,
+  /** Two 4 x 3 x 2.5 m open rooms side by side along x, joined by a door in a
+   *  10 cm shared wall (x in [4, 4.1]); both faces of the shared wall, its top,
+   *  the door's jambs and lintel and the floor strip under the door are sampled. */
+  DACPO_SCENE_TWO_ROOMS = 3,
+  /** Floating thin board 1.0 x 0.6 x 0.02 m centred at the origin, all six faces;
+   *  parts 0..5 are the faces +x, -x, +y, -y, +z (top), -z (bottom). */
+  DACPO_SCENE_BOARD = 4,
+  /** Half cylinder: radius 1, axis y, y in [-1, 1], the z >= 0 half, normals
+   *  outward. One part. */
+  DACPO_SCENE_HALF_CYLINDER = 5,
+  /** S-shaped sheet in the xz plane extruded along y (y in [-1, 1]): two half
+   *  circles of radius 0.5 joined at (0, 1); part 0 lower arc, part 1 upper arc;
+   *  normals consistent across the joint. */
+  DACPO_SCENE_S_SHEET = 6,
+  /** Open box room 4 x 3 x 2.5 m, x in [0, 4], y in [0, 3]: floor and the inner
+   *  faces of four walls (5 parts), no ceiling. */
+  DACPO_SCENE_BOX_OPEN = 7,
+  DACPO_SCENE_KIND_COUNT = 8
+} dacpo_scene_kind;
+
+/** \brief Room scene dimensions (DACPO_SCENE_ROOM), metres. */
+#define DACPO_SCENE_ROOM_SIZE_X 6.0
+#define DACPO_SCENE_ROOM_SIZE_Y 5.0
+#define DACPO_SCENE_ROOM_HEIGHT 2.6
+
+/** \brief Generation parameters; fill with dacpo_scene_params_init() first. */
+typedef struct dacpo_scene_params {
+  unsigned kind;        /**< a ::dacpo_scene_kind; default DACPO_SCENE_ROOM */
+  size_t target_points; /**< points sampled before downsampling; default 100000 */
+  double noise_sigma;   /**< Gaussian displacement sigma in metres (paper: 0.004,
+                             0.008); default 0 = no noise */
+  size_t downsample_to; /**< keep a random subset of this many points (order
+                             preserved); 0 = keep all; default 0 */
+  uint64_t seed;        /**< default 1 */
+} dacpo_scene_params;
+
+/** \brief A generated scene. All arrays are owned; free with dacpo_scene_free(). */
+typedef struct dacpo_scene {
+  size_t n;               /**< number of points */
+  float* xyz;             /**< 3n coordinates */
+  float* normals;         /**< 3n unit ground-truth normals, pointing into free space */
+  int32_t* part;          /**< n surface-patch ids in [0, num_parts) */
+  size_t num_parts;       /**< number of surface patches */
+  int32_t* part_object;   /**< num_parts object ids in [0, num_objects) */
+  size_t num_objects;     /**< number of objects (floor, wall, table, ...) */
+  const char** object_name; /**< num_objects names (static strings, array owned) */
+} dacpo_scene;
+
+/** \brief Name of a scene kind ("room", "plane", ...), or NULL when out of range. */
+const char*
+dacpo_scene_kind_name(unsigned kind);
+
+/** \brief Scene kind from its name; returns 0 and sets *kind, or -1 if unknown. */
+int
+dacpo_scene_kind_from_name(const char* name, unsigned* kind);
+
+/** \brief Set the documented defaults. NULL-safe. */
+void
+dacpo_scene_params_init(dacpo_scene_params* params);
+
+/**
+ * \brief Generate a scene.
+ * \param[in]  params  parameters (see dacpo_scene_params)
+ * \param[out] out     the scene; zeroed first, left empty on failure
+ * \param[out] err     message buffer (may be NULL)
+ * \param[in]  errlen  size of err
+ * \return 0 on success; -1 for invalid arguments (NULL pointer, unknown kind,
+ *         target_points == 0, negative or non-finite noise, downsample_to >
+ *         target_points), -2 when out of memory.
+ * Cost: O(target_points) time and memory (28 bytes per point).
+ */
+int
+dacpo_scene_generate(const dacpo_scene_params* params,
+                     dacpo_scene* out,
+                     char* err,
+                     size_t errlen);
+
+/** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
+void
+dacpo_scene_free(dacpo_scene* scene);
+
+/**
+ * \brief Copy n normals and flip the sign of exactly round(fraction * n) of them,
+ *        chosen uniformly at random (deterministic per seed).
+ * \param[in]  normals_in   3n floats
+ * \param[out] normals_out  3n floats; may equal normals_in (in place)
+ * \param[in]  fraction     clamped to [0, 1]
+ * \return the number of flipped normals.
+ */
+size_t
+dacpo_scramble_signs(const float* normals_in,
+                     float* normals_out,
+                     size_t n,
+                     uint64_t seed,
+                     double fraction);
+
+/** \brief dacpo_scramble_signs() applied to the scene's ground-truth normals. */
+size_t
+dacpo_scene_scramble_signs(const dacpo_scene* scene,
+                           float* normals_out,
+                           uint64_t seed,
+                           double fraction);
+
+/**
+ * \brief The paper's metric: percentage of points whose predicted normal makes
+ *        more than 90 degrees with the ground truth, after one free sign.
+ *
+ * Without labels (component == NULL) the whole prediction may be flipped once,
+ * so the result is at most 50 %. With labels, each label value (any int32) gets
+ * its own free sign. A point whose dot product is zero or not finite counts as
+ * wrong under either sign.
+ * \param[out] wrong_out  number of wrong points (may be NULL)
+ * \return the percentage in [0, 100]; 0 when n == 0; -1 when gt or pred is NULL
+ *         (with n > 0) or out of memory.
+ */
+double
+dacpo_score_oriented(const float* gt,
+                     const float* pred,
+                     size_t n,
+                     const int32_t* component,
+                     size_t* wrong_out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DACPO_SCENE_H */
