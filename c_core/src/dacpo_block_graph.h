@@ -27,6 +27,11 @@ dacpo_block_graph_build(const dacpo_blocks* blocks,
 void
 dacpo_block_graph_free(dacpo_block_graph* g);
 
+/* Index of the edge joining blocks a and b (either order) by binary search,
+ * or -1 when they are not adjacent. */
+ptrdiff_t
+dacpo_block_graph_find(const dacpo_block_graph* g, int32_t a, int32_t b);
+
 /* Dipole-boundary weight: for every adjacency pair (p in a, q in b),
  * s = e((p,n_p),(q,n_q)) + e((q,n_q),(p,n_p)) with the current oriented normals
  * (Eq. 2); alpha sums max(s, 0), alpha_bar sums max(-s, 0) (flipping b negates

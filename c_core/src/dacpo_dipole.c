@@ -63,7 +63,7 @@ dacpo_dipole_energy(const double p[3],
 
 /* Everything one call allocates; freed in one place. */
 typedef struct dipole_work {
-  int32_t* nb;      /* n*K nearest neighbours, -1 padded */
+  int32_t* nb;      /* n*K nearest neighbours, padded with the point itself */
   double* w;        /* n*K e(p_j -> p_i) of the unflipped axes */
   size_t* gstart;   /* n+1 CSR of the symmetrized graph_k-NN graph */
   int32_t* gnbr;    /* gstart[n] */
@@ -128,8 +128,10 @@ dipole_neighbors(const double* xyz,
                                     nrm + 3 * i, c);
       ++t;
     }
+    /* Pad short rows (only with exact duplicates) with the point itself and a
+     * zero weight, so the decision loops need no branch. */
     for (; t < K; ++t) {
-      row[t] = -1;
+      row[t] = (int32_t)i;
       wrow[t] = 0.0;
     }
   }
@@ -147,7 +149,7 @@ dipole_graph(size_t n, size_t K, size_t gk, dipole_work* wk, dacpo_err* err)
   for (size_t i = 0; i < n; ++i)
     for (size_t t = 0; t < gk; ++t) {
       const int32_t j = wk->nb[i * K + t];
-      if (j < 0)
+      if ((size_t)j == i)
         continue;
       wk->gstart[i + 1]++;
       wk->gstart[(size_t)j + 1]++;
@@ -169,13 +171,30 @@ dipole_graph(size_t n, size_t K, size_t gk, dipole_work* wk, dacpo_err* err)
   for (size_t i = 0; i < n; ++i)
     for (size_t t = 0; t < gk; ++t) {
       const int32_t j = wk->nb[i * K + t];
-      if (j < 0)
+      if ((size_t)j == i)
         continue;
       wk->gnbr[fill[i]++] = j;
       wk->gnbr[fill[(size_t)j]++] = (int32_t)i;
     }
   free(fill);
   return DACPO_OK;
+}
+
+/* sum_t s[row[t]] * w[t]; four partial sums break the add latency chain. */
+static double
+dipole_field_sum(const int32_t* row, const double* w, size_t K, const int8_t* s)
+{
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+  size_t t = 0;
+  for (; t + 4 <= K; t += 4) {
+    a0 += (double)s[row[t]] * w[t];
+    a1 += (double)s[row[t + 1]] * w[t + 1];
+    a2 += (double)s[row[t + 2]] * w[t + 2];
+    a3 += (double)s[row[t + 3]] * w[t + 3];
+  }
+  for (; t < K; ++t)
+    a0 += (double)s[row[t]] * w[t];
+  return (a0 + a1) + (a2 + a3);
 }
 
 /* Greedy sign of point i from its placed neighbours (Eq. 4). A point with no
@@ -185,13 +204,10 @@ dipole_decide(const dipole_work* wk, size_t K, size_t i, const int8_t* s)
 {
   const int32_t* row = wk->nb + i * K;
   const double* wrow = wk->w + i * K;
-  double sum = 0.0;
-  for (size_t t = 0; t < K; ++t) {
-    const int32_t j = row[t];
-    if (j >= 0 && s[j] != 0)
-      sum += (double)s[j] * wrow[t];
-  }
-  return sum >= 0.0 ? 1 : -1;
+  /* Unplaced points have s == 0 and drop out without a branch: whether a
+   * neighbour is placed is random, a branch on it would mispredict half the
+   * time and cost more than the sum itself. */
+  return dipole_field_sum(row, wrow, K, s) >= 0.0 ? 1 : -1;
 }
 
 /* One randomized BFS order; signs placed in s (length n, zeroed here). */
@@ -343,10 +359,7 @@ dacpo_dipole_orient(const double* xyz,
       const size_t i = (size_t)wk.order0[o];
       const int32_t* row = wk.nb + i * K;
       const double* wrow = wk.w + i * K;
-      double sum = 0.0;
-      for (size_t t = 0; t < K; ++t)
-        if (row[t] >= 0)
-          sum += (double)sign_out[row[t]] * wrow[t];
+      const double sum = dipole_field_sum(row, wrow, K, sign_out);
       if (sum > 0.0)
         sign_out[i] = 1;
       else if (sum < 0.0)

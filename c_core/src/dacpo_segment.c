@@ -48,38 +48,64 @@ seg_check_cloud(const dacpo_cloud* cloud,
                 dacpo_blocks* out,
                 dacpo_err* err)
 {
-  DACPO_CHECK(err, cloud != NULL && component != NULL && out != NULL,
-              DACPO_ERR_INVALID_ARGUMENT, "segment: NULL cloud, component or output");
-  DACPO_CHECK(err, cloud->n > 0, DACPO_ERR_EMPTY_INPUT, "segment: the cloud has no points");
-  DACPO_CHECK(err, cloud->n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "segment: %zu points exceed int32 indices", cloud->n);
-  DACPO_CHECK(err, num_components > 0 && num_components <= (size_t)INT32_MAX,
-              DACPO_ERR_INVALID_ARGUMENT, "segment: num_components is %zu", num_components);
+  DACPO_CHECK(err,
+              cloud != NULL && component != NULL && out != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "segment: NULL cloud, component or output");
+  DACPO_CHECK(
+      err, cloud->n > 0, DACPO_ERR_EMPTY_INPUT, "segment: the cloud has no points");
+  DACPO_CHECK(err,
+              cloud->n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "segment: %zu points exceed int32 indices",
+              cloud->n);
+  DACPO_CHECK(err,
+              num_components > 0 && num_components <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "segment: num_components is %zu",
+              num_components);
   for (size_t i = 0; i < cloud->n; ++i)
-    DACPO_CHECK(err, component[i] >= 0 && (size_t)component[i] < num_components,
+    DACPO_CHECK(err,
+                component[i] >= 0 && (size_t)component[i] < num_components,
                 DACPO_ERR_INVALID_ARGUMENT,
-                "segment: point %zu has component %ld, outside [0, %zu)", i,
-                (long)component[i], num_components);
+                "segment: point %zu has component %ld, outside [0, %zu)",
+                i,
+                (long)component[i],
+                num_components);
   return DACPO_OK;
 }
 
 static dacpo_status
 seg_check_adjacency(const dacpo_adjacency* adj, size_t n, dacpo_err* err)
 {
-  DACPO_CHECK(err, adj != NULL && adj->start != NULL, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              adj != NULL && adj->start != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
               "segment: NULL adjacency");
-  DACPO_CHECK(err, adj->n == n, DACPO_ERR_INVALID_ARGUMENT,
-              "segment: adjacency has %zu points, cloud has %zu", adj->n, n);
-  DACPO_CHECK(err, adj->start[0] == 0 && (adj->start[n] == 0 || adj->nbr != NULL),
-              DACPO_ERR_INVALID_ARGUMENT, "segment: malformed adjacency arrays");
+  DACPO_CHECK(err,
+              adj->n == n,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "segment: adjacency has %zu points, cloud has %zu",
+              adj->n,
+              n);
+  DACPO_CHECK(err,
+              adj->start[0] == 0 && (adj->start[n] == 0 || adj->nbr != NULL),
+              DACPO_ERR_INVALID_ARGUMENT,
+              "segment: malformed adjacency arrays");
   for (size_t i = 0; i < n; ++i) {
-    DACPO_CHECK(err, adj->start[i] <= adj->start[i + 1], DACPO_ERR_INVALID_ARGUMENT,
-                "segment: adjacency row %zu has a decreasing start", i);
+    DACPO_CHECK(err,
+                adj->start[i] <= adj->start[i + 1],
+                DACPO_ERR_INVALID_ARGUMENT,
+                "segment: adjacency row %zu has a decreasing start",
+                i);
     for (size_t e = adj->start[i]; e < adj->start[i + 1]; ++e)
-      DACPO_CHECK(err, adj->nbr[e] >= 0 && (size_t)adj->nbr[e] < n,
+      DACPO_CHECK(err,
+                  adj->nbr[e] >= 0 && (size_t)adj->nbr[e] < n,
                   DACPO_ERR_INVALID_ARGUMENT,
-                  "segment: adjacency row %zu lists point %ld, outside [0, %zu)", i,
-                  (long)adj->nbr[e], n);
+                  "segment: adjacency row %zu lists point %ld, outside [0, %zu)",
+                  i,
+                  (long)adj->nbr[e],
+                  n);
   }
   return DACPO_OK;
 }
@@ -93,7 +119,7 @@ typedef struct seg_splitter {
   int32_t* idx;   /* working permutation of the component's points */
   int32_t* seeds; /* output, in recursion (left first) order */
   size_t num_seeds;
-  dacpo_rng rng;  /* quickselect pivots only; fixed seed, so deterministic */
+  dacpo_rng rng; /* quickselect pivots only; fixed seed, so deterministic */
 } seg_splitter;
 
 /* Strict order on (coordinate, index): all keys distinct, so quickselect never
@@ -367,17 +393,19 @@ dacpo_segment(const dacpo_cloud* cloud,
   DACPO_TRY(seg_check_cloud(cloud, component, num_components, out, err));
   const size_t n = cloud->n;
   DACPO_TRY(seg_check_adjacency(adj, n, err));
-  DACPO_CHECK(err, cloud->xyz != NULL, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              cloud->xyz != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
               "segment: cloud has no coordinates");
 
   dacpo_status st = DACPO_OK;
   dacpo_blocks res;
   memset(&res, 0, sizeof(res));
-  size_t* comp_start = NULL;  /* num_components + 1 */
-  size_t* nblk = NULL;        /* blocks wanted per component */
+  size_t* comp_start = NULL; /* num_components + 1 */
+  size_t* nblk = NULL;       /* blocks wanted per component */
   seg_splitter sp;
   memset(&sp, 0, sizeof(sp));
-  int32_t* raw_comp = NULL;   /* component of each raw (pre-renumbering) block */
+  int32_t* raw_comp = NULL; /* component of each raw (pre-renumbering) block */
   int32_t* queue = NULL;
   size_t* raw_size = NULL;
   int32_t* remap = NULL;
@@ -447,9 +475,11 @@ dacpo_segment(const dacpo_cloud* cloud,
       raw_comp[s] = (int32_t)c;
   }
   if (sp.num_seeds != total) {
-    st = dacpo_err_set(err, DACPO_ERR_INTERNAL,
+    st = dacpo_err_set(err,
+                       DACPO_ERR_INTERNAL,
                        "segment: kd split produced %zu seeds, expected %zu",
-                       sp.num_seeds, total);
+                       sp.num_seeds,
+                       total);
     goto fail;
   }
 
@@ -503,7 +533,8 @@ dacpo_segment(const dacpo_cloud* cloud,
     for (size_t c = 0; c < num_components; ++c)
       per_comp[c + 1] += per_comp[c];
     res.num_blocks = per_comp[num_components];
-    res.component_of_block = (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
+    res.component_of_block =
+        (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
     if (res.component_of_block == NULL) {
       free(per_comp);
       st = DACPO_OOM(err);
@@ -573,7 +604,8 @@ dacpo_segment_single(const dacpo_cloud* cloud,
   for (size_t c = 0; c < num_components; ++c)
     if (comp_block[c] == 0)
       comp_block[c] = (int32_t)res.num_blocks++;
-  res.component_of_block = (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
+  res.component_of_block =
+      (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
   res.ring_start = (size_t*)dacpo_calloc_array(res.num_blocks + 1, sizeof(size_t));
   res.ring = (int32_t*)dacpo_malloc_array(0, sizeof(int32_t));
   if (res.component_of_block == NULL || res.ring_start == NULL || res.ring == NULL) {

@@ -31,10 +31,15 @@ struct Scene {
   dacpo_cloud cloud{};
   dacpo_adjacency adj{};
 
-  size_t n() const { return xyz.size() / 3; }
+  size_t
+  n() const
+  {
+    return xyz.size() / 3;
+  }
 
   // Call after xyz/start/nbr are final.
-  void finish()
+  void
+  finish()
   {
     size_t count = n();
     nrm.assign(3 * count, 0.0);
@@ -168,7 +173,10 @@ random_knn_scene(size_t count, size_t k, uint32_t seed)
 // Hop distance from the set `src` over adj, restricted to component comp,
 // up to max_hops (-1 = farther / unreachable).
 std::vector<int>
-hop_distance(const Scene& s, const std::vector<int32_t>& src, int32_t comp, int max_hops)
+hop_distance(const Scene& s,
+             const std::vector<int32_t>& src,
+             int32_t comp,
+             int max_hops)
 {
   std::vector<int> dist(s.n(), -1);
   std::deque<int32_t> q;
@@ -192,10 +200,9 @@ hop_distance(const Scene& s, const std::vector<int32_t>& src, int32_t comp, int 
   return dist;
 }
 
-// Checks every structural promise of dacpo_blocks; ring checked against brute
-// force BFS when check_ring.
+// Checks every structural promise of dacpo_blocks; rings against brute-force BFS.
 void
-expect_valid(const Scene& s, const dacpo_blocks& b, size_t ring_hops, bool check_ring = true)
+expect_valid(const Scene& s, const dacpo_blocks& b, size_t ring_hops)
 {
   const size_t n = s.n();
   ASSERT_GT(b.num_blocks, 0u);
@@ -210,14 +217,16 @@ expect_valid(const Scene& s, const dacpo_blocks& b, size_t ring_hops, bool check
   std::vector<int> seen(n, 0);
   for (size_t k = 0; k < b.num_blocks; ++k) {
     ASSERT_LT(b.own_start[k], b.own_start[k + 1]) << "block " << k << " is empty";
-    if (k > 0) // numbered component by component
+    if (k > 0) { // numbered component by component
       EXPECT_LE(b.component_of_block[k - 1], b.component_of_block[k]);
+    }
     for (size_t t = b.own_start[k]; t < b.own_start[k + 1]; ++t) {
       int32_t p = b.own[t];
       ASSERT_GE(p, 0);
       ASSERT_LT((size_t)p, n);
-      if (t > b.own_start[k])
+      if (t > b.own_start[k]) {
         EXPECT_LT(b.own[t - 1], p) << "own list of block " << k << " not ascending";
+      }
       EXPECT_EQ(b.block_of[p], (int32_t)k);
       EXPECT_EQ(s.component[(size_t)p], b.component_of_block[k]);
       seen[(size_t)p]++;
@@ -254,9 +263,8 @@ expect_valid(const Scene& s, const dacpo_blocks& b, size_t ring_hops, bool check
       EXPECT_TRUE(ring.empty());
       continue;
     }
-    if (!check_ring)
-      continue;
-    std::vector<int> dist = hop_distance(s, own, b.component_of_block[k], (int)ring_hops);
+    std::vector<int> dist =
+        hop_distance(s, own, b.component_of_block[k], (int)ring_hops);
     std::vector<int32_t> want;
     for (size_t i = 0; i < n; ++i)
       if (dist[i] >= 1)
@@ -281,14 +289,15 @@ TEST(DacpoSegment, GridSplitsIntoSixteenConnectedEqualBlocks)
   Scene s = grid_scene(100, 100);
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 16, 2, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 16, 2, &b, &err),
+            DACPO_OK)
       << err.msg;
   EXPECT_EQ(b.num_blocks, 16u);
   for (size_t sz : block_sizes(b)) {
     EXPECT_GE(sz, 625u / 2);
     EXPECT_LE(sz, 625u * 2);
   }
-  expect_valid(s, b, 2, /*check_ring=*/false);
+  expect_valid(s, b, 2);
   dacpo_blocks_free(&b);
 }
 
@@ -303,7 +312,8 @@ TEST(DacpoSegment, TwoComponentsGetDisjointProportionalBlocks)
   s.finish();
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 10, 1, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 10, 1, &b, &err),
+            DACPO_OK)
       << err.msg;
   // round(10 * 3600 / 4500) = 8 and round(10 * 900 / 4500) = 2
   ASSERT_EQ(b.num_blocks, 10u);
@@ -340,15 +350,10 @@ TEST(DacpoSegment, RingMatchesBruteForceOnKnnGraph)
   Scene s = random_knn_scene(1500, 8, 7);
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud,
-                          &s.adj,
-                          s.component.data(),
-                          s.num_components,
-                          12,
-                          3,
-                          &b,
-                          &err),
-            DACPO_OK)
+  ASSERT_EQ(
+      dacpo_segment(
+          &s.cloud, &s.adj, s.component.data(), s.num_components, 12, 3, &b, &err),
+      DACPO_OK)
       << err.msg;
   EXPECT_GE(b.num_blocks, 12u);
   expect_valid(s, b, 3);
@@ -360,7 +365,8 @@ TEST(DacpoSegment, ZeroHopsGivesEmptyRings)
   Scene s = grid_scene(30, 30);
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 5, 0, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 5, 0, &b, &err),
+            DACPO_OK)
       << err.msg;
   EXPECT_EQ(b.num_blocks, 5u);
   EXPECT_EQ(b.ring_start[b.num_blocks], 0u);
@@ -405,7 +411,8 @@ TEST(DacpoSegment, SinglePointComponentGetsItsOwnBlock)
   s.finish();
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 4, 2, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 4, 2, &b, &err),
+            DACPO_OK)
       << err.msg;
   // round(4 * 1 / 1601) = 0 -> 1 block; round(4 * 1600 / 1601) = 4
   ASSERT_EQ(b.num_blocks, 5u);
@@ -428,7 +435,8 @@ TEST(DacpoSegment, TargetZeroMeansOneBlockPerComponent)
   s.finish();
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 0, 3, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 2, 0, 3, &b, &err),
+            DACPO_OK)
       << err.msg;
   ASSERT_EQ(b.num_blocks, 2u);
   EXPECT_EQ(b.own_start[1], 400u);
@@ -465,18 +473,20 @@ TEST(DacpoSegment, RunsAreDeterministic)
   Scene s = random_knn_scene(1200, 6, 3);
   dacpo_blocks a{}, b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), s.num_components, 9, 2, &a,
-                          &err),
+  ASSERT_EQ(dacpo_segment(
+                &s.cloud, &s.adj, s.component.data(), s.num_components, 9, 2, &a, &err),
             DACPO_OK);
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), s.num_components, 9, 2, &b,
-                          &err),
+  ASSERT_EQ(dacpo_segment(
+                &s.cloud, &s.adj, s.component.data(), s.num_components, 9, 2, &b, &err),
             DACPO_OK);
   ASSERT_EQ(a.num_blocks, b.num_blocks);
   const size_t n = s.n();
   EXPECT_EQ(0, std::memcmp(a.block_of, b.block_of, n * sizeof(int32_t)));
   EXPECT_EQ(0, std::memcmp(a.own, b.own, n * sizeof(int32_t)));
-  EXPECT_EQ(0, std::memcmp(a.ring_start, b.ring_start, (a.num_blocks + 1) * sizeof(size_t)));
-  EXPECT_EQ(0, std::memcmp(a.ring, b.ring, a.ring_start[a.num_blocks] * sizeof(int32_t)));
+  EXPECT_EQ(
+      0, std::memcmp(a.ring_start, b.ring_start, (a.num_blocks + 1) * sizeof(size_t)));
+  EXPECT_EQ(0,
+            std::memcmp(a.ring, b.ring, a.ring_start[a.num_blocks] * sizeof(int32_t)));
   dacpo_blocks_free(&a);
   dacpo_blocks_free(&b);
 }
@@ -493,7 +503,8 @@ TEST(DacpoSegment, MislabelledComponentStillLabelsEveryPoint)
   s.finish();
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 1, 1, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 1, 1, &b, &err),
+            DACPO_OK)
       << err.msg;
   EXPECT_EQ(b.num_blocks, 2u);
   expect_valid(s, b, 1);
@@ -511,7 +522,8 @@ TEST(DacpoSegment, BadArgumentsAreRejected)
             DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 2, 1, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_segment_single(&s.cloud, nullptr, 1, &b, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_segment_single(&s.cloud, nullptr, 1, &b, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
 
   s.component[7] = 3; // outside [0, 1)
   EXPECT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 2, 1, &b, &err),

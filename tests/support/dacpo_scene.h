@@ -80,13 +80,13 @@ typedef struct dacpo_scene_params {
 
 /** \brief A generated scene. All arrays are owned; free with dacpo_scene_free(). */
 typedef struct dacpo_scene {
-  size_t n;               /**< number of points */
-  float* xyz;             /**< 3n coordinates */
-  float* normals;         /**< 3n unit ground-truth normals, pointing into free space */
-  int32_t* part;          /**< n surface-patch ids in [0, num_parts) */
-  size_t num_parts;       /**< number of surface patches */
-  int32_t* part_object;   /**< num_parts object ids in [0, num_objects) */
-  size_t num_objects;     /**< number of objects (floor, wall, table, ...) */
+  size_t n;             /**< number of points */
+  float* xyz;           /**< 3n coordinates */
+  float* normals;       /**< 3n unit ground-truth normals, pointing into free space */
+  int32_t* part;        /**< n surface-patch ids in [0, num_parts) */
+  size_t num_parts;     /**< number of surface patches */
+  int32_t* part_object; /**< num_parts object ids in [0, num_objects) */
+  size_t num_objects;   /**< number of objects (floor, wall, table, ...) */
   const char** object_name; /**< num_objects names (static strings, array owned) */
 } dacpo_scene;
 

@@ -1,0 +1,76 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/**
+ * \file dacpo_ply.h
+ * \brief Minimal PLY input/output for point clouds with normals (tests, tools).
+ *
+ * Writes binary little-endian PLY with vertex properties `float x y z` and, when
+ * normals are given, `float nx ny nz` (the layout of the real-scan test files).
+ * Reads ascii, binary_little_endian and binary_big_endian PLY: the vertex
+ * element must have x, y, z; nx, ny, nz are optional; other vertex properties
+ * (any scalar type, lists too) and other elements are skipped. Values of any
+ * numeric type are converted to float.
+ *
+ * Bad input (missing file, garbage, bad header, truncated data, absurd counts)
+ * returns an error code and a message; nothing here crashes, prints or aborts.
+ * No global state: safe to call from several threads on different files.
+ */
+#ifndef DACPO_PLY_H
+#define DACPO_PLY_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** \brief Return codes of the PLY functions. */
+enum {
+  DACPO_PLY_OK = 0,
+  DACPO_PLY_ERR_ARGUMENT = -1, /**< NULL pointer or bad argument */
+  DACPO_PLY_ERR_MEMORY = -2,   /**< out of memory */
+  DACPO_PLY_ERR_IO = -3,       /**< cannot open, read, write or close the file */
+  DACPO_PLY_ERR_FORMAT = -4 /**< not a PLY, unsupported or bad header, truncated data */
+};
+
+/** \brief A point cloud read from a PLY file; free with dacpo_ply_cloud_free(). */
+typedef struct dacpo_ply_cloud {
+  size_t n;       /**< number of vertices */
+  float* xyz;     /**< 3n coordinates (NULL when n == 0) */
+  float* normals; /**< 3n normals, or NULL when the file has no nx, ny, nz */
+} dacpo_ply_cloud;
+
+/**
+ * \brief Write n points as binary little-endian PLY.
+ * \param[in] path     output file (created or truncated)
+ * \param[in] xyz      3n floats (may be NULL only when n == 0)
+ * \param[in] normals  3n floats, or NULL to write positions only
+ * \param[in] comment  text for `comment` header lines (one per line), or NULL
+ * \param[out] err     message buffer (may be NULL)
+ * \return DACPO_PLY_OK, DACPO_PLY_ERR_ARGUMENT or DACPO_PLY_ERR_IO.
+ */
+int
+dacpo_ply_write(const char* path,
+                const float* xyz,
+                const float* normals,
+                size_t n,
+                const char* comment,
+                char* err,
+                size_t errlen);
+
+/**
+ * \brief Read the vertex positions (and normals when present) of a PLY file.
+ * \param[out] out  zeroed first; owns the arrays on success, empty on failure
+ * \return DACPO_PLY_OK or a negative DACPO_PLY_ERR_* code with a message in err.
+ */
+int
+dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen);
+
+/** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
+void
+dacpo_ply_cloud_free(dacpo_ply_cloud* cloud);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DACPO_PLY_H */
