@@ -1,0 +1,1357 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * Stage 5: the 0-1 block-flip program (paper §5.2, Eq. 8; ALGORITHM.md §5).
+ *
+ * Every block i gets a flip o_i in {0,1}; Eq. 8 maximizes
+ *   sum_{(i,j) in E} omega_ij(o_i, o_j),
+ * with omega(0,0) = omega(1,1) = w_same and omega(0,1) = omega(1,0) = w_diff.
+ * With y_e = o_a XOR o_b this is  const + sum_e c_e y_e,  c_e = w_diff - w_same,
+ * i.e. a max-cut problem. Here:
+ *   1. parallel edges are merged (their weights add), self loops are constants;
+ *   2. the edge graph is split into connected components; each is solved on its
+ *      own with its lowest node fixed to 0 (a component's global sign is free),
+ *      isolated nodes get 0;
+ *   3. a heuristic incumbent for the whole graph, always: maximum spanning tree
+ *      on the confidence |c_e| (Kruskal), flips propagated along it, then local
+ *      search with subtree flips (all subtrees of the tree scored at once via
+ *      LCAs), single-node flips (best gain first) and greedily grown connected
+ *      cluster flips; then up to 16 restarts from random spanning trees, the
+ *      best per component kept. It is exact on trees and on components whose
+ *      edges can all be satisfied at once; those never reach lp_solve;
+ *   4. every other component goes to lp_solve: binary o_i and y_e, all four XOR
+ *      inequalities per edge, and the triangle inequalities of every 3-cycle
+ *      (y_ab <= y_ac + y_bc and rotations, y_ab + y_ac + y_bc <= 2). ALGORITHM.md
+ *      §5 measured that the XOR rows alone leave lp_solve slow and far from the
+ *      optimum, while the triangle rows make the relaxation nearly integral.
+ *      Where the relaxation is still fractional, violated odd-cycle inequalities
+ *      (found by shortest paths in the doubled "parity" graph, Barahona &
+ *      Mahjoub 1986) are added as cutting planes before branch and bound;
+ *   5. the better of lp_solve's answer and the incumbent is kept per component;
+ *      a relaxation bound the incumbent reaches proves it optimal directly.
+ *
+ * Inputs: number of blocks, edges with omega(0,0) and omega(0,1), a time limit,
+ * an optional progress callback (wired to lp_solve's abort hook).
+ * Outputs: flip per block; objective recomputed from the flips (the LP value is
+ * not trusted), whether optimality was proven, rows given to lp_solve, cuts,
+ * components where the incumbent beat lp_solve, wall time.
+ * Cost: heuristic per start O(m log m + passes * (moves * (n + m) + seeds * L *
+ * frontier)) with cluster size L <= 48 (~0.01 s for 200 blocks);
+ * triangle enumeration O(sum_e min-degree) by intersecting sorted neighbour
+ * lists; lp_solve is exponential in the worst case, bounded by the time limit.
+ * Failure modes: bad arguments (INVALID_ARGUMENT naming the edge),
+ * allocation failure (OUT_OF_MEMORY), cancellation (CANCELLED). A time-out or an
+ * lp_solve failure is not an error: the incumbent is used and optimal = 0.
+ *
+ * This is the only file of the project that includes lp_lib.h (it defines TRUE,
+ * FALSE, LE, GE, ... as macros).
+ */
+#include "dacpo_ilp.h"
+
+#include <lp_lib.h>
+
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Largest cluster grown by one cluster flip of the local search. */
+#define ILP_CLUSTER_MAX 48
+/* Cluster-flip passes over all seeds (each pass is followed by single flips). */
+#define ILP_CLUSTER_PASSES 8
+/* Random spanning trees tried after the maximum-confidence one. */
+#define ILP_TREE_RESTARTS 16
+/* Rounds of odd-cycle separation on the LP relaxation before branch and bound. */
+#define ILP_CUT_ROUNDS 20
+/* A relaxation value farther than this from 0 and 1 is fractional. */
+#define ILP_FRAC_EPS 1e-6
+/* Minimum violation of a cut worth adding. */
+#define ILP_CUT_EPS 1e-4
+/* Minimum time between two progress calls from inside lp_solve (seconds). */
+#define ILP_PROGRESS_PERIOD 0.02
+
+/* ---------------------------------------------------------------------------
+ * The merged edge graph and its components
+ * ------------------------------------------------------------------------- */
+
+typedef struct ilp_graph {
+  size_t n;            /* nodes */
+  size_t m;            /* merged edges, ea < eb */
+  int32_t* ea;
+  int32_t* eb;
+  double* c;           /* w_diff - w_same: what cutting the edge (y_e = 1) gains */
+  size_t* adj_start;   /* n + 1 */
+  int32_t* adj_node;   /* 2m, ascending within each node */
+  int32_t* adj_edge;   /* 2m, merged edge of each adjacency entry */
+  int32_t* comp;       /* component of each node */
+  size_t ncomp;
+  size_t* comp_start;  /* ncomp + 1, into comp_nodes */
+  int32_t* comp_nodes; /* ascending within a component: the lowest comes first */
+  size_t* cedge_start; /* ncomp + 1, into cedges */
+  int32_t* cedges;     /* merged edges grouped by component, ascending */
+} ilp_graph;
+
+static void
+ilp_graph_free(ilp_graph* g)
+{
+  free(g->ea);
+  free(g->eb);
+  free(g->c);
+  free(g->adj_start);
+  free(g->adj_node);
+  free(g->adj_edge);
+  free(g->comp);
+  free(g->comp_start);
+  free(g->comp_nodes);
+  free(g->cedge_start);
+  free(g->cedges);
+  memset(g, 0, sizeof(*g));
+}
+
+typedef struct ilp_pair {
+  int32_t a, b; /* a < b */
+  size_t idx;   /* input edge */
+} ilp_pair;
+
+static int
+ilp_pair_cmp(const void* pa, const void* pb)
+{
+  const ilp_pair* x = (const ilp_pair*)pa;
+  const ilp_pair* y = (const ilp_pair*)pb;
+  if (x->a != y->a)
+    return x->a < y->a ? -1 : 1;
+  if (x->b != y->b)
+    return x->b < y->b ? -1 : 1;
+  return (x->idx > y->idx) - (x->idx < y->idx);
+}
+
+static dacpo_status
+ilp_graph_build(size_t n,
+                size_t num_edges,
+                const dacpo_ilp_edge* edges,
+                ilp_graph* g,
+                dacpo_err* err)
+{
+  memset(g, 0, sizeof(*g));
+  g->n = n;
+  size_t np = 0;
+  for (size_t i = 0; i < num_edges; ++i)
+    np += edges[i].a != edges[i].b;
+  ilp_pair* pairs = dacpo_malloc_array(np, sizeof(*pairs));
+  if (!pairs)
+    return DACPO_OOM(err);
+  np = 0;
+  for (size_t i = 0; i < num_edges; ++i) {
+    int32_t a = edges[i].a, b = edges[i].b;
+    if (a == b)
+      continue; /* a self loop is always "same": a constant of Eq. 8 */
+    pairs[np].a = a < b ? a : b;
+    pairs[np].b = a < b ? b : a;
+    pairs[np].idx = i;
+    ++np;
+  }
+  qsort(pairs, np, sizeof(*pairs), ilp_pair_cmp);
+  size_t m = 0;
+  for (size_t i = 0; i < np; ++i)
+    m += i == 0 || pairs[i].a != pairs[i - 1].a || pairs[i].b != pairs[i - 1].b;
+
+  g->m = m;
+  g->ea = dacpo_malloc_array(m, sizeof(int32_t));
+  g->eb = dacpo_malloc_array(m, sizeof(int32_t));
+  g->c = dacpo_calloc_array(m, sizeof(double));
+  g->adj_start = dacpo_calloc_array(n + 1, sizeof(size_t));
+  g->adj_node = dacpo_malloc_array(2 * m, sizeof(int32_t));
+  g->adj_edge = dacpo_malloc_array(2 * m, sizeof(int32_t));
+  g->comp = dacpo_malloc_array(n, sizeof(int32_t));
+  if (!g->ea || !g->eb || !g->c || !g->adj_start || !g->adj_node || !g->adj_edge ||
+      !g->comp) {
+    free(pairs);
+    ilp_graph_free(g);
+    return DACPO_OOM(err);
+  }
+  size_t e = 0;
+  for (size_t i = 0; i < np; ++i) {
+    if (i > 0 && (pairs[i].a != pairs[i - 1].a || pairs[i].b != pairs[i - 1].b))
+      ++e;
+    const dacpo_ilp_edge* in = &edges[pairs[i].idx];
+    g->ea[e] = pairs[i].a;
+    g->eb[e] = pairs[i].b;
+    g->c[e] += in->w_diff - in->w_same; /* parallel edges add up in Eq. 8 */
+  }
+  free(pairs);
+
+  /* CSR adjacency. Filling in (a, b) order leaves every list ascending: the
+   * smaller neighbours of v come from edges (x, v), x < v, which sort before the
+   * edges (v, y). The intersection of triangle enumeration relies on it. */
+  for (size_t k = 0; k < m; ++k) {
+    g->adj_start[g->ea[k] + 1]++;
+    g->adj_start[g->eb[k] + 1]++;
+  }
+  for (size_t v = 0; v < n; ++v)
+    g->adj_start[v + 1] += g->adj_start[v];
+  size_t* fill = dacpo_malloc_array(n + 1, sizeof(size_t));
+  if (!fill) {
+    ilp_graph_free(g);
+    return DACPO_OOM(err);
+  }
+  memcpy(fill, g->adj_start, (n + 1) * sizeof(size_t));
+  for (size_t k = 0; k < m; ++k) {
+    int32_t a = g->ea[k], b = g->eb[k];
+    g->adj_node[fill[a]] = b;
+    g->adj_edge[fill[a]++] = (int32_t)k;
+    g->adj_node[fill[b]] = a;
+    g->adj_edge[fill[b]++] = (int32_t)k;
+  }
+
+  /* Components by BFS from the lowest unvisited node (fill reused as queue). */
+  for (size_t v = 0; v < n; ++v)
+    g->comp[v] = -1;
+  size_t ncomp = 0;
+  for (size_t s = 0; s < n; ++s) {
+    if (g->comp[s] >= 0)
+      continue;
+    size_t head = 0, tail = 0;
+    fill[tail++] = s;
+    g->comp[s] = (int32_t)ncomp;
+    while (head < tail) {
+      size_t v = fill[head++];
+      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+        int32_t u = g->adj_node[q];
+        if (g->comp[u] < 0) {
+          g->comp[u] = (int32_t)ncomp;
+          fill[tail++] = (size_t)u;
+        }
+      }
+    }
+    ++ncomp;
+  }
+  free(fill);
+  g->ncomp = ncomp;
+  g->comp_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
+  g->comp_nodes = dacpo_malloc_array(n, sizeof(int32_t));
+  g->cedge_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
+  g->cedges = dacpo_malloc_array(m, sizeof(int32_t));
+  size_t* cfill = dacpo_malloc_array(ncomp + 1, sizeof(size_t));
+  if (!g->comp_start || !g->comp_nodes || !g->cedge_start || !g->cedges || !cfill) {
+    free(cfill);
+    ilp_graph_free(g);
+    return DACPO_OOM(err);
+  }
+  /* Counting sorts keep nodes and edges ascending inside each component. */
+  for (size_t v = 0; v < n; ++v)
+    g->comp_start[g->comp[v] + 1]++;
+  for (size_t c = 0; c < ncomp; ++c)
+    g->comp_start[c + 1] += g->comp_start[c];
+  memcpy(cfill, g->comp_start, (ncomp + 1) * sizeof(size_t));
+  for (size_t v = 0; v < n; ++v)
+    g->comp_nodes[cfill[g->comp[v]]++] = (int32_t)v;
+  for (size_t k = 0; k < m; ++k)
+    g->cedge_start[g->comp[g->ea[k]] + 1]++;
+  for (size_t c = 0; c < ncomp; ++c)
+    g->cedge_start[c + 1] += g->cedge_start[c];
+  memcpy(cfill, g->cedge_start, (ncomp + 1) * sizeof(size_t));
+  for (size_t k = 0; k < m; ++k)
+    g->cedges[cfill[g->comp[g->ea[k]]]++] = (int32_t)k;
+  free(cfill);
+  return DACPO_OK;
+}
+
+/* sum over a component's edges of c_e y_e (Eq. 8 without its constant) */
+static double
+ilp_comp_value(const ilp_graph* g, size_t ci, const uint8_t* o)
+{
+  double s = 0.0;
+  for (size_t q = g->cedge_start[ci]; q < g->cedge_start[ci + 1]; ++q) {
+    int32_t e = g->cedges[q];
+    if (o[g->ea[e]] != o[g->eb[e]])
+      s += g->c[e];
+  }
+  return s;
+}
+
+/* ---------------------------------------------------------------------------
+ * Heuristic incumbent: maximum-confidence spanning tree + local search
+ * ------------------------------------------------------------------------- */
+
+typedef struct ilp_key {
+  double key;
+  int32_t e;
+} ilp_key;
+
+static int
+ilp_key_desc(const void* pa, const void* pb)
+{
+  const ilp_key* x = (const ilp_key*)pa;
+  const ilp_key* y = (const ilp_key*)pb;
+  if (x->key != y->key)
+    return x->key > y->key ? -1 : 1;
+  return (x->e > y->e) - (x->e < y->e);
+}
+
+static int32_t
+ilp_find(int32_t* parent, int32_t v)
+{
+  while (parent[v] != v) {
+    parent[v] = parent[parent[v]]; /* path halving */
+    v = parent[v];
+  }
+  return v;
+}
+
+/* The term of edge e in the gain of flipping one of its ends. */
+static double
+ilp_term(const ilp_graph* g, const uint8_t* o, int32_t e)
+{
+  return (o[g->ea[e]] != o[g->eb[e]]) ? -g->c[e] : g->c[e];
+}
+
+/* Flips node v and keeps gain[] (objective change of flipping each node) exact. */
+static void
+ilp_flip_node(const ilp_graph* g, uint8_t* o, double* gain, int32_t v)
+{
+  for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+    int32_t u = g->adj_node[q];
+    gain[u] -= 2.0 * ilp_term(g, o, g->adj_edge[q]);
+  }
+  gain[v] = -gain[v];
+  o[v] ^= 1u;
+}
+
+/* Flips the single node of best positive gain until none is left. */
+static void
+ilp_single_flips(const ilp_graph* g, uint8_t* o, double* gain, double tol)
+{
+  size_t limit = 16 * g->n + 64; /* each flip gains > tol; this only guards rounding */
+  for (size_t it = 0; it < limit; ++it) {
+    int32_t best = -1;
+    double bg = tol;
+    for (size_t v = 0; v < g->n; ++v)
+      if (gain[v] > bg) {
+        bg = gain[v];
+        best = (int32_t)v;
+      }
+    if (best < 0)
+      return;
+    ilp_flip_node(g, o, gain, best);
+  }
+}
+
+typedef struct ilp_cluster_ws {
+  uint8_t* in_s;     /* node is in the cluster */
+  uint8_t* in_f;     /* node is on the frontier */
+  double* inner;     /* sum of terms of edges from the node into the cluster */
+  int32_t* members;  /* cluster in growth order */
+  int32_t* frontier;
+  int32_t* touched;  /* nodes whose in_f / inner must be reset */
+} ilp_cluster_ws;
+
+/* Grows a connected cluster from seed s, each step adding the frontier node
+ * that raises the cluster's flip gain most, and flips the best prefix if it
+ * gains. Flipping S changes exactly the edges leaving S; adding v to S turns
+ * its edges into S from cut-changing to internal: delta = gain[v] - 2 inner[v]. */
+static int
+ilp_grow_cluster(const ilp_graph* g,
+                 uint8_t* o,
+                 double* gain,
+                 ilp_cluster_ws* w,
+                 int32_t s,
+                 double tol)
+{
+  size_t ns = 0, nf = 0, nt = 0;
+  double cur = 0.0, best = tol;
+  size_t bestk = 0;
+  int32_t v = s;
+  double delta = gain[s];
+  for (;;) {
+    cur += delta;
+    w->in_s[v] = 1;
+    w->members[ns++] = v;
+    if (cur > best) {
+      best = cur;
+      bestk = ns;
+    }
+    for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+      int32_t u = g->adj_node[q];
+      if (w->in_s[u])
+        continue;
+      if (!w->in_f[u]) {
+        w->in_f[u] = 1;
+        w->inner[u] = 0.0;
+        w->frontier[nf++] = u;
+        w->touched[nt++] = u;
+      }
+      w->inner[u] += ilp_term(g, o, g->adj_edge[q]);
+    }
+    if (ns >= ILP_CLUSTER_MAX || nf == 0)
+      break;
+    size_t bi = 0;
+    double bd = -INFINITY;
+    for (size_t i = 0; i < nf; ++i) {
+      double d = gain[w->frontier[i]] - 2.0 * w->inner[w->frontier[i]];
+      if (d > bd) {
+        bd = d;
+        bi = i;
+      }
+    }
+    v = w->frontier[bi];
+    delta = bd;
+    w->frontier[bi] = w->frontier[--nf];
+    w->in_f[v] = 0;
+  }
+  for (size_t i = 0; i < nt; ++i)
+    w->in_f[w->touched[i]] = 0;
+  for (size_t i = 0; i < ns; ++i)
+    w->in_s[w->members[i]] = 0;
+  for (size_t i = 0; i < bestk; ++i)
+    ilp_flip_node(g, o, gain, w->members[i]);
+  return bestk > 0;
+}
+
+/* The maximum-confidence spanning forest, rooted at each component's lowest
+ * node, in preorder (a subtree is a contiguous range of order[]). */
+typedef struct ilp_tree {
+  int32_t* order;  /* preorder of all nodes, component by component */
+  int32_t* pos;    /* node -> index in order */
+  int32_t* size;   /* subtree size */
+  int32_t* parent; /* -1 at roots */
+  int32_t* pedge;  /* edge to the parent, -1 at roots */
+  int32_t* depth;
+  int32_t* lca;    /* per merged edge: lowest common ancestor of its ends */
+  double* acc;     /* scratch: subtree-gain accumulation */
+} ilp_tree;
+
+static void
+ilp_tree_free(ilp_tree* t)
+{
+  free(t->order);
+  free(t->pos);
+  free(t->size);
+  free(t->parent);
+  free(t->pedge);
+  free(t->depth);
+  free(t->lca);
+  free(t->acc);
+}
+
+/* Kruskal on |c_e| (the most confident edges decide the relative flips; with
+ * rng, on |c_e| times a uniform random factor, for the restarts), a preorder of
+ * the forest, and the LCA of every edge's ends by binary lifting. */
+static dacpo_status
+ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
+{
+  size_t n = g->n, m = g->m;
+  dacpo_status st = DACPO_OK;
+  memset(t, 0, sizeof(*t));
+  t->order = dacpo_malloc_array(n, sizeof(int32_t));
+  t->pos = dacpo_malloc_array(n, sizeof(int32_t));
+  t->size = dacpo_malloc_array(n, sizeof(int32_t));
+  t->parent = dacpo_malloc_array(n, sizeof(int32_t));
+  t->pedge = dacpo_malloc_array(n, sizeof(int32_t));
+  t->depth = dacpo_malloc_array(n, sizeof(int32_t));
+  t->lca = dacpo_malloc_array(m, sizeof(int32_t));
+  t->acc = dacpo_malloc_array(n, sizeof(double));
+  ilp_key* keys = dacpo_malloc_array(m, sizeof(*keys));
+  int32_t* uf = dacpo_malloc_array(n, sizeof(int32_t));
+  uint8_t* in_tree = dacpo_calloc_array(m, 1);
+  int32_t* stack = dacpo_malloc_array(n, sizeof(int32_t));
+  size_t levels = 1;
+  while (levels < 31 && ((size_t)1 << levels) < n)
+    ++levels;
+  int32_t* up = dacpo_malloc_array(n, levels * sizeof(int32_t));
+  if (!t->order || !t->pos || !t->size || !t->parent || !t->pedge || !t->depth ||
+      !t->lca || !t->acc || !keys || !uf || !in_tree || !stack || !up) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    keys[k].key = fabs(g->c[k]) * (rng ? dacpo_rng_uniform(rng) : 1.0);
+    keys[k].e = (int32_t)k;
+  }
+  qsort(keys, m, sizeof(*keys), ilp_key_desc);
+  for (size_t v = 0; v < n; ++v)
+    uf[v] = (int32_t)v;
+  for (size_t k = 0; k < m; ++k) {
+    int32_t e = keys[k].e;
+    int32_t ra = ilp_find(uf, g->ea[e]), rb = ilp_find(uf, g->eb[e]);
+    if (ra == rb)
+      continue;
+    uf[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    in_tree[e] = 1;
+  }
+  /* Iterative DFS preorder from each component's lowest node. */
+  for (size_t v = 0; v < n; ++v)
+    t->pos[v] = -1;
+  size_t no = 0;
+  for (size_t ci = 0; ci < g->ncomp; ++ci) {
+    int32_t root = g->comp_nodes[g->comp_start[ci]];
+    size_t sp = 0;
+    stack[sp++] = root;
+    t->parent[root] = -1;
+    t->pedge[root] = -1;
+    t->depth[root] = 0;
+    while (sp > 0) {
+      int32_t v = stack[--sp];
+      t->pos[v] = (int32_t)no;
+      t->order[no++] = v;
+      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+        int32_t u = g->adj_node[q], e = g->adj_edge[q];
+        if (!in_tree[e] || u == t->parent[v])
+          continue;
+        t->parent[u] = v;
+        t->pedge[u] = e;
+        t->depth[u] = t->depth[v] + 1;
+        stack[sp++] = u;
+      }
+    }
+  }
+  for (size_t i = n; i-- > 0;) {
+    int32_t v = t->order[i];
+    t->size[v] = 1;
+  }
+  for (size_t i = n; i-- > 0;) {
+    int32_t v = t->order[i];
+    if (t->parent[v] >= 0)
+      t->size[t->parent[v]] += t->size[v];
+  }
+  /* Binary lifting: up[l * n + v] is the 2^l-th ancestor (roots map to self). */
+  for (size_t v = 0; v < n; ++v)
+    up[v] = t->parent[v] >= 0 ? t->parent[v] : (int32_t)v;
+  for (size_t l = 1; l < levels; ++l)
+    for (size_t v = 0; v < n; ++v)
+      up[l * n + v] = up[(l - 1) * n + up[(l - 1) * n + v]];
+  for (size_t k = 0; k < m; ++k) {
+    int32_t a = g->ea[k], b = g->eb[k];
+    if (t->depth[a] < t->depth[b]) {
+      int32_t x = a;
+      a = b;
+      b = x;
+    }
+    int32_t diff = t->depth[a] - t->depth[b];
+    for (size_t l = 0; l < levels; ++l)
+      if (diff & (1 << l))
+        a = up[l * n + a];
+    if (a != b) {
+      for (size_t l = levels; l-- > 0;)
+        if (up[l * n + a] != up[l * n + b]) {
+          a = up[l * n + a];
+          b = up[l * n + b];
+        }
+      a = up[a];
+    }
+    t->lca[k] = a;
+  }
+done:
+  free(keys);
+  free(uf);
+  free(in_tree);
+  free(stack);
+  free(up);
+  if (st != DACPO_OK) {
+    ilp_tree_free(t);
+    memset(t, 0, sizeof(*t));
+  }
+  return st;
+}
+
+/* Subtree moves: flipping the subtree under v changes exactly the edges with
+ * one end inside, i.e. the edges whose tree path passes the parent edge of v.
+ * Adding each edge's term at both ends and -2x at their LCA, subtree sums give
+ * every subtree's gain in O(n + m); the best is flipped until none gains. This
+ * undoes a noisy but confident edge that the spanning tree trusted. */
+static int
+ilp_subtree_moves(const ilp_graph* g, const ilp_tree* t, uint8_t* o, double* gain, double tol)
+{
+  int improved = 0;
+  for (size_t it = 0; it < g->n; ++it) {
+    memset(t->acc, 0, g->n * sizeof(double));
+    for (size_t k = 0; k < g->m; ++k) {
+      double x = ilp_term(g, o, (int32_t)k);
+      t->acc[g->ea[k]] += x;
+      t->acc[g->eb[k]] += x;
+      t->acc[t->lca[k]] -= 2.0 * x;
+    }
+    int32_t best = -1;
+    double bg = tol;
+    for (size_t i = g->n; i-- > 0;) {
+      int32_t v = t->order[i];
+      if (t->parent[v] < 0)
+        continue;
+      if (t->acc[v] > bg) {
+        bg = t->acc[v];
+        best = v;
+      }
+      t->acc[t->parent[v]] += t->acc[v];
+    }
+    if (best < 0)
+      break;
+    for (int32_t i = t->pos[best]; i < t->pos[best] + t->size[best]; ++i)
+      ilp_flip_node(g, o, gain, t->order[i]);
+    improved = 1;
+  }
+  return improved;
+}
+
+/* Subtree, single and cluster moves until none gains (or the pass limit). */
+static void
+ilp_descend(const ilp_graph* g,
+            const ilp_tree* t,
+            ilp_cluster_ws* w,
+            uint8_t* o,
+            double* gain,
+            double tol)
+{
+  for (int pass = 0; pass < ILP_CLUSTER_PASSES; ++pass) {
+    int improved = ilp_subtree_moves(g, t, o, gain, tol);
+    ilp_single_flips(g, o, gain, tol);
+    if (w) {
+      /* A cluster can only gain across an unsatisfied edge (term > 0), so
+       * seeds are the ends of unsatisfied edges. */
+      for (size_t s = 0; s < g->n; ++s) {
+        int seed = 0;
+        for (size_t q = g->adj_start[s]; q < g->adj_start[s + 1] && !seed; ++q)
+          seed = ilp_term(g, o, g->adj_edge[q]) > 0.0;
+        if (seed)
+          improved |= ilp_grow_cluster(g, o, gain, w, (int32_t)s, tol);
+      }
+      ilp_single_flips(g, o, gain, tol);
+    }
+    if (!improved)
+      break;
+  }
+}
+
+/* Flips along the tree (each tree edge at its preferred value), gains, then
+ * local search. */
+static void
+ilp_start(const ilp_graph* g,
+          const ilp_tree* t,
+          ilp_cluster_ws* w,
+          uint8_t* o,
+          double* gain,
+          double tol)
+{
+  for (size_t i = 0; i < g->n; ++i) {
+    int32_t v = t->order[i];
+    o[v] = t->parent[v] < 0 ? 0
+                            : (uint8_t)(o[t->parent[v]] ^ (g->c[t->pedge[v]] > 0.0));
+  }
+  memset(gain, 0, g->n * sizeof(double));
+  for (size_t k = 0; k < g->m; ++k) {
+    double x = ilp_term(g, o, (int32_t)k);
+    gain[g->ea[k]] += x;
+    gain[g->eb[k]] += x;
+  }
+  ilp_descend(g, t, w, o, gain, tol);
+}
+
+/* The incumbent: the maximum-confidence tree, then restarts from random
+ * spanning trees (each a different basin for the local search; measured on the
+ * bench graphs, 16 restarts reached lp_solve's optimum where the single start
+ * stalled ~1 % below it). Restarts stop at stop_time, so a tiny time limit still
+ * gets the first answer. o gets the best; each component's lowest node is 0. */
+static dacpo_status
+ilp_heuristic(const ilp_graph* g, double stop_time, uint8_t* o, dacpo_err* err)
+{
+  size_t n = g->n, m = g->m;
+  dacpo_status st = DACPO_OK;
+  ilp_tree t;
+  DACPO_TRY(ilp_tree_build(g, NULL, &t, err));
+  double* gain = dacpo_malloc_array(n, sizeof(double));
+  uint8_t* o2 = dacpo_malloc_array(n, 1);
+  double* best = dacpo_malloc_array(g->ncomp, sizeof(double));
+  ilp_cluster_ws w;
+  w.in_s = dacpo_calloc_array(n, 1);
+  w.in_f = dacpo_calloc_array(n, 1);
+  w.inner = dacpo_calloc_array(n, sizeof(double));
+  w.members = dacpo_malloc_array(n, sizeof(int32_t));
+  w.frontier = dacpo_malloc_array(n, sizeof(int32_t));
+  w.touched = dacpo_malloc_array(n, sizeof(int32_t));
+  if (!gain || !o2 || !best || !w.in_s || !w.in_f || !w.inner || !w.members || !w.frontier ||
+      !w.touched) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  /* tol is relative to the weights, so rounding cannot make moves cycle */
+  double scale = 0.0;
+  for (size_t k = 0; k < m; ++k)
+    scale += fabs(g->c[k]);
+  double tol = 1e-12 * (1.0 + scale);
+
+  ilp_start(g, &t, &w, o, gain, tol);
+  for (size_t ci = 0; ci < g->ncomp; ++ci)
+    best[ci] = ilp_comp_value(g, ci, o);
+  dacpo_rng rng;
+  dacpo_rng_seed(&rng, 0x1d3c5a7ull, (uint64_t)n);
+  /* A forest (m = n - components) is solved exactly by the first tree. Each
+   * component keeps its best restart: their relative sign does not matter. */
+  for (int r = 0; r < ILP_TREE_RESTARTS && m + g->ncomp > n && dacpo_now() < stop_time;
+       ++r) {
+    ilp_tree_free(&t);
+    st = ilp_tree_build(g, &rng, &t, err);
+    if (st != DACPO_OK)
+      goto done;
+    ilp_start(g, &t, &w, o2, gain, tol);
+    for (size_t ci = 0; ci < g->ncomp; ++ci) {
+      double v = ilp_comp_value(g, ci, o2);
+      if (v > best[ci] + tol) {
+        best[ci] = v;
+        for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
+          o[g->comp_nodes[q]] = o2[g->comp_nodes[q]];
+      }
+    }
+  }
+  /* A component's lowest node is the fixed reference (o = 0). */
+  for (size_t ci = 0; ci < g->ncomp; ++ci)
+    if (o[g->comp_nodes[g->comp_start[ci]]])
+      for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
+        o[g->comp_nodes[q]] ^= 1u;
+
+done:
+  ilp_tree_free(&t);
+  free(gain);
+  free(o2);
+  free(best);
+  free(w.in_s);
+  free(w.in_f);
+  free(w.inner);
+  free(w.members);
+  free(w.frontier);
+  free(w.touched);
+  return st;
+}
+
+/* ---------------------------------------------------------------------------
+ * lp_solve
+ * ------------------------------------------------------------------------- */
+
+typedef struct ilp_abort {
+  const dacpo_progress* progress;
+  double deadline;
+  double fraction;
+  double last_call;
+  int cancelled;
+  int timed_out;
+} ilp_abort;
+
+/* lp_solve's abort hook: the time limit in fractions of a second (set_timeout
+ * only takes whole seconds) and the caller's cancel request. */
+static int __WINAPI
+ilp_abort_cb(lprec* lp, void* user)
+{
+  (void)lp;
+  ilp_abort* ab = (ilp_abort*)user;
+  /* lp_solve may poll again before it unwinds: the answer stays TRUE and the
+   * caller's callback is not asked twice */
+  if (ab->cancelled || ab->timed_out)
+    return TRUE;
+  double now = dacpo_now();
+  if (now >= ab->deadline) {
+    ab->timed_out = 1;
+    return TRUE;
+  }
+  if (ab->progress && ab->progress->fn && now - ab->last_call >= ILP_PROGRESS_PERIOD) {
+    ab->last_call = now;
+    if (ab->progress->fn(ab->progress->user, DACPO_STAGE_ILP, ab->fraction) != 0) {
+      ab->cancelled = 1;
+      return TRUE;
+    }
+  }
+  return FALSE;
+}
+
+/* Per-solve scratch, sized for the whole graph once. */
+typedef struct ilp_lp_ws {
+  int32_t* loc;   /* node -> local index in its component */
+  int32_t* ecol;  /* merged edge -> local edge index in its component */
+  double* vars;   /* lp_solve variables */
+  /* odd-cycle separation on the doubled graph (2 copies of each node) */
+  double* dist;
+  int32_t* pred;  /* predecessor adjacency entry * 2 + parity of the predecessor */
+  int32_t* heap;
+  int32_t* heap_pos;
+  uint8_t* mark;
+  int32_t* cyc_e;
+  uint64_t* cut_key; /* keys of the cuts added in the current round */
+  double* row;
+  int* col;
+} ilp_lp_ws;
+
+/* Adds one row. add_constraintex may reorder the arrays it is given
+ * (ALGORITHM.md §5), so the caller refills them before every call. */
+static int
+ilp_add_row(lprec* lp, int count, double* row, int* col, int type, double rhs, size_t* rows)
+{
+  if (!add_constraintex(lp, count, row, col, type, rhs))
+    return 0;
+  ++*rows;
+  return 1;
+}
+
+/* The four XOR rows of edge column ye between node columns ca, cb. */
+static int
+ilp_add_xor_rows(lprec* lp, int ye, int ca, int cb, size_t* rows)
+{
+  double r[3];
+  int c[3];
+  static const double sign[4][3] = {
+      {1, -1, 1}, {1, 1, -1}, {1, -1, -1}, {1, 1, 1}};
+  static const int type[4] = {GE, GE, LE, LE};
+  static const double rhs[4] = {0, 0, 0, 2};
+  /* y >= o_a - o_b, y >= o_b - o_a, y <= o_a + o_b, y <= 2 - o_a - o_b */
+  for (int k = 0; k < 4; ++k) {
+    r[0] = sign[k][0];
+    r[1] = sign[k][1];
+    r[2] = sign[k][2];
+    c[0] = ye;
+    c[1] = ca;
+    c[2] = cb;
+    if (!ilp_add_row(lp, 3, r, c, type[k], rhs[k], rows))
+      return 0;
+  }
+  return 1;
+}
+
+/* The four triangle rows of edge columns y1, y2, y3 of one 3-cycle. */
+static int
+ilp_add_triangle_rows(lprec* lp, int y1, int y2, int y3, size_t* rows)
+{
+  double r[3];
+  int c[3];
+  static const double sign[4][3] = {{1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  static const double rhs[4] = {0, 0, 0, 2};
+  for (int k = 0; k < 4; ++k) {
+    r[0] = sign[k][0];
+    r[1] = sign[k][1];
+    r[2] = sign[k][2];
+    c[0] = y1;
+    c[1] = y2;
+    c[2] = y3;
+    if (!ilp_add_row(lp, 3, r, c, LE, rhs[k], rows))
+      return 0;
+  }
+  return 1;
+}
+
+static void
+ilp_heap_up(int32_t* heap, int32_t* pos, const double* key, size_t i)
+{
+  int32_t v = heap[i];
+  while (i > 0) {
+    size_t p = (i - 1) / 2;
+    if (key[heap[p]] <= key[v])
+      break;
+    heap[i] = heap[p];
+    pos[heap[i]] = (int32_t)i;
+    i = p;
+  }
+  heap[i] = v;
+  pos[v] = (int32_t)i;
+}
+
+static void
+ilp_heap_down(int32_t* heap, int32_t* pos, const double* key, size_t size, size_t i)
+{
+  int32_t v = heap[i];
+  for (;;) {
+    size_t l = 2 * i + 1;
+    if (l >= size)
+      break;
+    size_t r = l + 1;
+    size_t s = (r < size && key[heap[r]] < key[heap[l]]) ? r : l;
+    if (key[heap[s]] >= key[v])
+      break;
+    heap[i] = heap[s];
+    pos[heap[i]] = (int32_t)i;
+    i = s;
+  }
+  heap[i] = v;
+  pos[v] = (int32_t)i;
+}
+
+/* Odd-cycle separation for one component (Barahona & Mahjoub): every cycle C
+ * and odd F subset of C give  sum_{F} (1 - y_e) + sum_{C \ F} y_e >= 1.  In the
+ * doubled graph, an edge keeps the parity with length y_e and switches it with
+ * length 1 - y_e; a path from (s,0) to (s,1) shorter than 1 is a violated
+ * inequality. Only simple cycles of length >= 4 are added (triangles are rows
+ * already). Returns the number of cuts added, or -1 if lp_solve refused a row. */
+static long
+ilp_separate(const ilp_graph* g,
+             size_t ci,
+             lprec* lp,
+             ilp_lp_ws* w,
+             int nc,
+             size_t* rows,
+             size_t max_cuts,
+             double deadline)
+{
+  size_t n0 = g->comp_start[ci], n1 = g->comp_start[ci + 1];
+  size_t nn = n1 - n0;
+  const double* y = w->vars + nc; /* edge values, local edge order */
+  long added = 0;
+  for (size_t si = n0; si < n1 && (size_t)added < max_cuts; ++si) {
+    if (dacpo_now() >= deadline)
+      break;
+    int32_t s = g->comp_nodes[si];
+    /* Dijkstra over doubled local nodes 2 * loc + parity. */
+    for (size_t i = 0; i < 2 * nn; ++i) {
+      w->dist[i] = INFINITY;
+      w->heap_pos[i] = -1;
+    }
+    size_t hs = 0;
+    int32_t src = 2 * w->loc[s], dst = src + 1;
+    w->dist[src] = 0.0;
+    w->pred[src] = -1;
+    w->heap[hs++] = src;
+    w->heap_pos[src] = 0;
+    while (hs > 0) {
+      int32_t x = w->heap[0];
+      w->heap_pos[x] = -2; /* settled */
+      w->heap[0] = w->heap[--hs];
+      if (hs > 0) {
+        w->heap_pos[w->heap[0]] = 0;
+        ilp_heap_down(w->heap, w->heap_pos, w->dist, hs, 0);
+      }
+      if (x == dst || w->dist[x] >= 1.0 - ILP_CUT_EPS)
+        break;
+      int32_t v = g->comp_nodes[n0 + (size_t)(x / 2)];
+      int par = x & 1;
+      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+        int32_t u = g->adj_node[q];
+        double ye = y[w->ecol[g->adj_edge[q]]];
+        ye = ye < 0.0 ? 0.0 : (ye > 1.0 ? 1.0 : ye);
+        for (int sw = 0; sw < 2; ++sw) {
+          int32_t z = 2 * w->loc[u] + (par ^ sw);
+          if (w->heap_pos[z] == -2)
+            continue;
+          double d = w->dist[x] + (sw ? 1.0 - ye : ye);
+          if (d < w->dist[z]) {
+            w->dist[z] = d;
+            w->pred[z] = (int32_t)(2 * q) + par;
+            if (w->heap_pos[z] < 0) {
+              w->heap[hs] = z;
+              w->heap_pos[z] = (int32_t)hs;
+              ++hs;
+            }
+            ilp_heap_up(w->heap, w->heap_pos, w->dist, (size_t)w->heap_pos[z]);
+          }
+        }
+      }
+    }
+    if (!(w->dist[dst] < 1.0 - ILP_CUT_EPS))
+      continue;
+    /* Walk back; keep only simple cycles. */
+    size_t len = 0, nf = 0;
+    int simple = 1;
+    int32_t x = dst;
+    while (x != src && simple) {
+      int32_t pq = w->pred[x];
+      size_t q = (size_t)(pq / 2);
+      int32_t ppar = pq & 1;
+      int32_t e = g->adj_edge[q];
+      /* q is in the predecessor's list: the predecessor is e's other end */
+      int32_t cur = g->comp_nodes[n0 + (size_t)(x / 2)];
+      int32_t owner = g->ea[e] == cur ? g->eb[e] : g->ea[e];
+      if (w->mark[w->loc[owner]] && owner != s)
+        simple = 0;
+      w->mark[w->loc[owner]] = 1;
+      int sw = (x & 1) != ppar;
+      w->cyc_e[len++] = sw ? -(e + 1) : (e + 1);
+      nf += (size_t)sw;
+      x = 2 * w->loc[owner] + ppar;
+    }
+    /* clear marks along the walked part */
+    for (size_t i = 0; i < len; ++i) {
+      int32_t e = w->cyc_e[i] > 0 ? w->cyc_e[i] - 1 : -w->cyc_e[i] - 1;
+      w->mark[w->loc[g->ea[e]]] = 0;
+      w->mark[w->loc[g->eb[e]]] = 0;
+    }
+    if (!simple || len < 4 || (nf & 1u) == 0)
+      continue;
+    /* Several sources find the same cycle: an order-free key drops repeats. */
+    uint64_t key = (uint64_t)len * 0x9e3779b97f4a7c15ull;
+    for (size_t i = 0; i < len; ++i) {
+      uint64_t z = (uint64_t)(int64_t)w->cyc_e[i] * 0xbf58476d1ce4e5b9ull;
+      z ^= z >> 31;
+      key += z * 0x94d049bb133111ebull;
+    }
+    int seen = 0;
+    for (long i = 0; i < added && !seen; ++i)
+      seen = w->cut_key[i] == key;
+    if (seen)
+      continue;
+    w->cut_key[added] = key;
+    /* sum_{F} y_e - sum_{C \ F} y_e <= |F| - 1 */
+    for (size_t i = 0; i < len; ++i) {
+      int32_t e = w->cyc_e[i] > 0 ? w->cyc_e[i] - 1 : -w->cyc_e[i] - 1;
+      w->row[i] = w->cyc_e[i] < 0 ? 1.0 : -1.0;
+      w->col[i] = nc + 1 + w->ecol[e];
+    }
+    if (!ilp_add_row(lp, (int)len, w->row, w->col, LE, (double)nf - 1.0, rows))
+      return -1;
+    ++added;
+  }
+  return added;
+}
+
+/* Reads o for the component from lp_solve's variables (rounded; the fixed node
+ * stays 0). Returns 1 if every node and edge value was integral. */
+static int
+ilp_read_flips(const ilp_graph* g, size_t ci, const double* vars, int ncols, uint8_t* o)
+{
+  int integral = 1;
+  for (int j = 0; j < ncols; ++j)
+    if (fabs(vars[j] - floor(vars[j] + 0.5)) > ILP_FRAC_EPS)
+      integral = 0;
+  size_t n0 = g->comp_start[ci];
+  for (size_t q = n0; q < g->comp_start[ci + 1]; ++q)
+    o[g->comp_nodes[q]] = vars[q - n0] > 0.5;
+  return integral;
+}
+
+typedef struct ilp_comp_out {
+  int have;              /* o holds an assignment from lp_solve */
+  int proven;            /* ... which lp_solve proved optimal */
+  int incumbent_optimal; /* the relaxation's bound equals the incumbent's value */
+} ilp_comp_out;
+
+/* Solves one component with lp_solve; writes its flips into o. incumbent is
+ * the heuristic's value of the component (sum of c_e y_e), tol the tolerance
+ * of value comparisons. */
+static dacpo_status
+ilp_lp_component(const ilp_graph* g,
+                 size_t ci,
+                 ilp_lp_ws* w,
+                 ilp_abort* ab,
+                 double incumbent,
+                 double tol,
+                 uint8_t* o,
+                 ilp_comp_out* out,
+                 dacpo_ilp_result* result,
+                 dacpo_err* err)
+{
+  memset(out, 0, sizeof(*out));
+  size_t n0 = g->comp_start[ci], n1 = g->comp_start[ci + 1];
+  size_t e0 = g->cedge_start[ci], e1 = g->cedge_start[ci + 1];
+  size_t nc = n1 - n0, mc = e1 - e0;
+  if (nc + mc > (size_t)INT_MAX - 1)
+    return DACPO_OK; /* too big for lp_solve's int columns: the incumbent stands */
+  for (size_t q = n0; q < n1; ++q)
+    w->loc[g->comp_nodes[q]] = (int32_t)(q - n0);
+  for (size_t q = e0; q < e1; ++q)
+    w->ecol[g->cedges[q]] = (int32_t)(q - e0);
+  int ncols = (int)(nc + mc);
+  /* columns: 1..nc nodes o_i (local order), nc+1..nc+mc edges y_e */
+  lprec* lp = make_lp(0, ncols);
+  if (!lp)
+    return DACPO_OK; /* lp_solve out of memory: the incumbent stands */
+  set_outputfile(lp, "");
+  set_verbose(lp, NEUTRAL);
+  /* The constraint matrix is all +-1, so lp_solve's scaling only costs time
+   * (measured: about 2x faster without); the objective is normalized to
+   * max |c| = 1 instead, so its tolerances mean the same for any weights.
+   * Dantzig pricing measured at least as fast as the default Devex here. */
+  set_scaling(lp, SCALE_NONE);
+  set_pivoting(lp, PRICER_DANTZIG | PRICE_ADAPTIVE);
+  double cmax = 0.0;
+  for (size_t k = 0; k < mc; ++k)
+    cmax = fmax(cmax, fabs(g->c[g->cedges[e0 + k]]));
+  if (!(cmax > 0.0))
+    cmax = 1.0;
+  int ok = 1;
+  for (size_t k = 0; k < mc; ++k) {
+    w->row[k] = g->c[g->cedges[e0 + k]] / cmax;
+    w->col[k] = (int)(nc + 1 + k);
+  }
+  ok = ok && set_obj_fnex(lp, (int)mc, w->row, w->col);
+  set_maxim(lp);
+  set_add_rowmode(lp, TRUE); /* after the objective, as lp_solve requires */
+  size_t rows = 0;
+  for (size_t k = 0; k < mc && ok; ++k) {
+    int32_t e = g->cedges[e0 + k];
+    int ye = (int)(nc + 1 + k);
+    ok = ilp_add_xor_rows(lp, ye, 1 + w->loc[g->ea[e]], 1 + w->loc[g->eb[e]], &rows);
+  }
+  /* Triangles a < b < x: intersect the ascending neighbour lists of a and b
+   * above b, so each 3-cycle is found once, from its lowest edge. */
+  for (size_t k = 0; k < mc && ok; ++k) {
+    /* building is not interruptible by lp_solve: watch the clock here */
+    if ((k & 255u) == 0 && dacpo_now() >= ab->deadline) {
+      ab->timed_out = 1;
+      ok = 0;
+      break;
+    }
+    int32_t e = g->cedges[e0 + k];
+    int32_t a = g->ea[e], b = g->eb[e];
+    size_t pa = g->adj_start[a], qa = g->adj_start[a + 1];
+    size_t pb = g->adj_start[b], qb = g->adj_start[b + 1];
+    while (pa < qa && g->adj_node[pa] <= b)
+      ++pa;
+    while (pb < qb && g->adj_node[pb] <= b)
+      ++pb;
+    while (pa < qa && pb < qb && ok) {
+      int32_t xa = g->adj_node[pa], xb = g->adj_node[pb];
+      if (xa < xb)
+        ++pa;
+      else if (xb < xa)
+        ++pb;
+      else {
+        ok = ilp_add_triangle_rows(lp,
+                                   (int)(nc + 1 + k),
+                                   (int)nc + 1 + w->ecol[g->adj_edge[pa]],
+                                   (int)nc + 1 + w->ecol[g->adj_edge[pb]],
+                                   &rows);
+        ++pa;
+        ++pb;
+      }
+    }
+  }
+  set_add_rowmode(lp, FALSE);
+  ok = ok && set_upbo(lp, 1, 0.0); /* the lowest node is the reference */
+  if (!ok) { /* out of time, or lp_solve refused a row: the incumbent stands */
+    result->constraints += rows;
+    delete_lp(lp);
+    return DACPO_OK;
+  }
+  put_abortfunc(lp, ilp_abort_cb, ab);
+
+  /* Cutting planes on the relaxation while it is fractional: each round adds
+   * the violated odd-cycle inequalities and re-solves (warm-started). An
+   * integral relaxation optimum is optimal for Eq. 8; a relaxation bound the
+   * incumbent reaches proves the incumbent optimal. */
+  int ret = NOFEASFOUND;
+  int relaxed_integral = 0;
+  double prev_bound = INFINITY;
+  for (int round = 0; round < ILP_CUT_ROUNDS; ++round) {
+    double remaining = ab->deadline - dacpo_now();
+    if (!(remaining > 0.0))
+      break;
+    set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
+    ret = solve(lp);
+    if (ab->cancelled || ret != OPTIMAL || !get_variables(lp, w->vars))
+      break;
+    if (ilp_read_flips(g, ci, w->vars, ncols, o)) {
+      relaxed_integral = 1;
+      break;
+    }
+    double bound = 0.0;
+    for (size_t k = 0; k < mc; ++k)
+      bound += g->c[g->cedges[e0 + k]] * w->vars[nc + k];
+    if (incumbent >= bound - tol) {
+      out->incumbent_optimal = 1;
+      break;
+    }
+    if (prev_bound - bound < 1e-6 * (1.0 + fabs(bound)))
+      break; /* tailing off: leave the rest to branch and bound */
+    prev_bound = bound;
+    long cuts = ilp_separate(g, ci, lp, w, (int)nc, &rows, 2 * nc + 16, ab->deadline);
+    if (cuts < 0) {
+      ok = 0;
+      break;
+    }
+    if (cuts == 0)
+      break;
+    result->cuts_added += (size_t)cuts;
+  }
+  if (relaxed_integral) {
+    out->have = 1;
+    out->proven = 1;
+  }
+  else if (ok && !ab->cancelled && !out->incumbent_optimal &&
+           ab->deadline - dacpo_now() > 0.0) {
+    /* Branch and bound on the strengthened model. */
+    for (int j = 1; j <= ncols; ++j)
+      set_binary(lp, j, TRUE);
+    set_upbo(lp, 1, 0.0);
+    double remaining = ab->deadline - dacpo_now();
+    set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
+    ret = solve(lp);
+    if (!ab->cancelled) {
+      /* after an abort or time-out, lp_solve's variables are its best
+       * improved solution, if it found any */
+      int usable = ret == OPTIMAL || ret == SUBOPTIMAL || ret == PRESOLVED ||
+                   ((ret == USERABORT || ret == TIMEOUT || ret == FEASFOUND) &&
+                    get_solutioncount(lp) > 0);
+      if (usable && get_variables(lp, w->vars)) {
+        ilp_read_flips(g, ci, w->vars, ncols, o);
+        out->have = 1;
+        out->proven = ret == OPTIMAL;
+      }
+    }
+  }
+  result->constraints += rows;
+  delete_lp(lp);
+  if (ab->cancelled)
+    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+  return DACPO_OK;
+}
+
+/* ---------------------------------------------------------------------------
+ * Entry point
+ * ------------------------------------------------------------------------- */
+
+static dacpo_status
+ilp_check(size_t num_nodes,
+          size_t num_edges,
+          const dacpo_ilp_edge* edges,
+          double time_limit,
+          const uint8_t* flip_out,
+          const dacpo_ilp_result* result,
+          dacpo_err* err)
+{
+  DACPO_CHECK(err, result != NULL, DACPO_ERR_INVALID_ARGUMENT, "ilp: NULL result");
+  DACPO_CHECK(err, num_nodes == 0 || flip_out != NULL, DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: NULL flip_out for %zu nodes", num_nodes);
+  DACPO_CHECK(err, num_edges == 0 || edges != NULL, DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: NULL edges for %zu edges", num_edges);
+  DACPO_CHECK(err, num_nodes <= (size_t)INT32_MAX / 4 && num_edges <= (size_t)INT32_MAX / 4,
+              DACPO_ERR_INVALID_ARGUMENT, "ilp: %zu nodes / %zu edges exceed int32 indices",
+              num_nodes, num_edges);
+  DACPO_CHECK(err, time_limit > 0.0, DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: time_limit must be > 0 (got %g)", time_limit);
+  for (size_t i = 0; i < num_edges; ++i) {
+    const dacpo_ilp_edge* e = &edges[i];
+    DACPO_CHECK(err, e->a >= 0 && (size_t)e->a < num_nodes && e->b >= 0 &&
+                         (size_t)e->b < num_nodes,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "ilp: edge %zu joins nodes %ld and %ld, outside [0, %zu)", i, (long)e->a,
+                (long)e->b, num_nodes);
+    DACPO_CHECK(err, isfinite(e->w_same) && isfinite(e->w_diff),
+                DACPO_ERR_INVALID_ARGUMENT, "ilp: edge %zu has weights %g / %g", i,
+                e->w_same, e->w_diff);
+  }
+  return DACPO_OK;
+}
+
+static int
+ilp_progress(const dacpo_progress* progress, double fraction)
+{
+  return progress && progress->fn &&
+         progress->fn(progress->user, DACPO_STAGE_ILP, fraction) != 0;
+}
+
+dacpo_status
+dacpo_ilp_solve(size_t num_nodes,
+                size_t num_edges,
+                const dacpo_ilp_edge* edges,
+                double time_limit,
+                const dacpo_progress* progress,
+                uint8_t* flip_out,
+                dacpo_ilp_result* result,
+                dacpo_err* err)
+{
+  double t0 = dacpo_now();
+  DACPO_TRY(ilp_check(num_nodes, num_edges, edges, time_limit, flip_out, result, err));
+  memset(result, 0, sizeof(*result));
+  result->optimal = 1;
+  if (ilp_progress(progress, 0.0))
+    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+
+  ilp_graph g;
+  DACPO_TRY(ilp_graph_build(num_nodes, num_edges, edges, &g, err));
+  dacpo_status st = DACPO_OK;
+  uint8_t* o = dacpo_calloc_array(num_nodes, 1);
+  uint8_t* o_lp = dacpo_calloc_array(num_nodes, 1);
+  ilp_lp_ws w;
+  memset(&w, 0, sizeof(w));
+  size_t nmax = num_nodes + g.m + 1;
+  w.loc = dacpo_malloc_array(num_nodes + 1, sizeof(int32_t));
+  w.ecol = dacpo_malloc_array(g.m + 1, sizeof(int32_t));
+  w.vars = dacpo_calloc_array(nmax, sizeof(double));
+  w.dist = dacpo_malloc_array(2 * num_nodes + 2, sizeof(double));
+  w.pred = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
+  w.heap = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
+  w.heap_pos = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
+  w.mark = dacpo_calloc_array(num_nodes + 1, 1);
+  w.cyc_e = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
+  w.cut_key = dacpo_malloc_array(2 * num_nodes + 16, sizeof(uint64_t));
+  w.row = dacpo_malloc_array(nmax + 2 * num_nodes, sizeof(double));
+  w.col = dacpo_malloc_array(nmax + 2 * num_nodes, sizeof(int));
+  if (!o || !o_lp || !w.loc || !w.ecol || !w.vars || !w.dist || !w.pred || !w.heap ||
+      !w.heap_pos || !w.mark || !w.cyc_e || !w.cut_key || !w.row || !w.col) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+
+  /* Restarts of the heuristic may use a quarter of the time limit. */
+  st = ilp_heuristic(&g, t0 + 0.25 * time_limit, o, err);
+  if (st != DACPO_OK)
+    goto done;
+
+  double scale = 0.0;
+  for (size_t k = 0; k < g.m; ++k)
+    scale += fabs(g.c[k]);
+  double tol = 1e-9 * (1.0 + scale);
+  ilp_abort ab;
+  memset(&ab, 0, sizeof(ab));
+  ab.progress = progress;
+  ab.deadline = t0 + time_limit; /* +inf: no limit */
+  ab.last_call = -INFINITY;
+  for (size_t ci = 0; ci < g.ncomp; ++ci) {
+    size_t nc = g.comp_start[ci + 1] - g.comp_start[ci];
+    size_t mc = g.cedge_start[ci + 1] - g.cedge_start[ci];
+    if (mc + 1 <= nc)
+      continue; /* single node or tree: the spanning-tree propagation is exact */
+    double h = ilp_comp_value(&g, ci, o);
+    double ub = 0.0; /* every edge at its preferred value */
+    for (size_t q = g.cedge_start[ci]; q < g.cedge_start[ci + 1]; ++q)
+      ub += g.c[g.cedges[q]] > 0.0 ? g.c[g.cedges[q]] : 0.0;
+    if (h >= ub - tol)
+      continue; /* nothing is frustrated: the incumbent reaches the bound */
+    ab.fraction = (double)g.comp_start[ci] / (double)num_nodes;
+    if (ilp_progress(progress, ab.fraction)) {
+      st = dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+      goto done;
+    }
+    if (!(ab.deadline - dacpo_now() > 0.0)) {
+      result->optimal = 0; /* out of time: the incumbent stands */
+      result->heuristic_wins++;
+      continue;
+    }
+    ilp_comp_out out;
+    st = ilp_lp_component(&g, ci, &w, &ab, h, tol, o_lp, &out, result, err);
+    if (st != DACPO_OK)
+      goto done;
+    if (out.incumbent_optimal)
+      continue;
+    double l = out.have ? ilp_comp_value(&g, ci, o_lp) : -INFINITY;
+    if (out.have && l >= h) {
+      for (size_t q = g.comp_start[ci]; q < g.comp_start[ci + 1]; ++q)
+        o[g.comp_nodes[q]] = o_lp[g.comp_nodes[q]];
+    }
+    else
+      result->heuristic_wins++;
+    /* A "proven" optimum that the incumbent beats was a numerical accident. */
+    if (!out.have || !out.proven || h > l + tol)
+      result->optimal = 0;
+  }
+  if (ilp_progress(progress, 1.0)) {
+    st = dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+    goto done;
+  }
+
+  /* Eq. 8 at the returned flips, from the caller's own edges. */
+  double obj = 0.0;
+  for (size_t i = 0; i < num_edges; ++i)
+    obj += o[edges[i].a] == o[edges[i].b] ? edges[i].w_same : edges[i].w_diff;
+  result->objective = obj;
+  if (num_nodes > 0)
+    memcpy(flip_out, o, num_nodes);
+
+done:
+  result->seconds = dacpo_now() - t0;
+  free(o);
+  free(o_lp);
+  free(w.loc);
+  free(w.ecol);
+  free(w.vars);
+  free(w.dist);
+  free(w.pred);
+  free(w.heap);
+  free(w.heap_pos);
+  free(w.mark);
+  free(w.cyc_e);
+  free(w.cut_key);
+  free(w.row);
+  free(w.col);
+  ilp_graph_free(&g);
+  return st;
+}
