@@ -37,14 +37,20 @@ dacpo_input_check(const float* xyz, const float* normals, size_t count, dacpo_er
   /* An empty std::vector may hand over data() == NULL: report it as empty. */
   DACPO_CHECK(err, count > 0, DACPO_ERR_EMPTY_INPUT, "the input has no points");
   DACPO_CHECK(err, xyz != NULL, DACPO_ERR_INVALID_ARGUMENT, "xyz is NULL");
-  DACPO_CHECK(err, count <= (size_t)INT32_MAX - 1, DACPO_ERR_INVALID_ARGUMENT,
-              "%zu points exceed the supported maximum of %d", count, INT32_MAX - 1);
+  DACPO_CHECK(err,
+              count <= (size_t)INT32_MAX - 1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "%zu points exceed the supported maximum of %d",
+              count,
+              INT32_MAX - 1);
   for (size_t i = 0; i < count; ++i) {
     for (int d = 0; d < 3; ++d) {
       float v = xyz[3 * i + d];
       if (!isfinite(v))
-        return dacpo_err_set(err, DACPO_ERR_NONFINITE_INPUT,
-                             "point %zu has a non-finite coordinate (%s)", i,
+        return dacpo_err_set(err,
+                             DACPO_ERR_NONFINITE_INPUT,
+                             "point %zu has a non-finite coordinate (%s)",
+                             i,
                              nonfinite_name(v));
     }
   }
@@ -55,13 +61,16 @@ dacpo_input_check(const float* xyz, const float* normals, size_t count, dacpo_er
     for (int d = 0; d < 3; ++d) {
       float v = normals[3 * i + d];
       if (!isfinite(v))
-        return dacpo_err_set(err, DACPO_ERR_NONFINITE_INPUT,
-                             "point %zu has a non-finite normal (%s)", i, nonfinite_name(v));
+        return dacpo_err_set(err,
+                             DACPO_ERR_NONFINITE_INPUT,
+                             "point %zu has a non-finite normal (%s)",
+                             i,
+                             nonfinite_name(v));
       n2 += (double)v * (double)v;
     }
     if (!(n2 >= DACPO_MIN_NORMAL_NORM * DACPO_MIN_NORMAL_NORM))
-      return dacpo_err_set(err, DACPO_ERR_NONFINITE_INPUT, "point %zu has a zero-length normal",
-                           i);
+      return dacpo_err_set(
+          err, DACPO_ERR_NONFINITE_INPUT, "point %zu has a zero-length normal", i);
   }
   return DACPO_OK;
 }

@@ -15,6 +15,15 @@ typedef struct dacpo_ipsr_params {
   double point_weight;    /* screening alpha */
   double cell_per_spacing; /* cell size / median spacing */
   size_t max_resolution;  /* cap on cells per axis */
+  /* Added by the stage-3 implementation (defaults from dacpo_ipsr_params_default;
+   * 0 selects the default for the first four): */
+  double padding;           /* box grows by this share of its longest side (0.1) */
+  size_t max_cells;         /* cap on grid cells, bounds memory (2^21) */
+  double tolerance;         /* Poisson solve: relative residual (1e-3) */
+  size_t max_cg_iterations; /* Poisson solve: multigrid-CG steps (30) */
+  int trim_interior;        /* 1: trim every far face, also inside the data (0) */
+  size_t band;              /* Poisson domain: cells within this many cells of the
+                               samples; 0 = the whole padded box (6) */
 } dacpo_ipsr_params;
 
 void
@@ -25,6 +34,18 @@ typedef struct dacpo_ipsr_stats {
   size_t resolution;  /* cells per axis used */
   double seconds;
   size_t peak_bytes;
+  /* Added by the stage-3 implementation: */
+  double spacing;        /* sample spacing (sqrt of the median area per sample) */
+  double cell;           /* grid cell edge */
+  size_t dims[3];        /* grid cells per axis */
+  size_t cg_iterations;  /* summed over iterations */
+  double solve_seconds;  /* Poisson solves */
+  double extract_seconds; /* marching cubes */
+  double vote_seconds;   /* face k-NN, trimming, normal update */
+  size_t faces;          /* faces of the last iteration's mesh */
+  double final_change;   /* last convergence measure */
+  int converged;         /* 1 if it stopped on the convergence test */
+  size_t domain_cells;   /* cells the Poisson solve works on (<= dims product) */
 } dacpo_ipsr_stats;
 
 /* Refines the oriented normals nrm (3n, in/out) of a block's n samples; the

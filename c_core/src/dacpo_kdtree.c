@@ -8,7 +8,7 @@
  * and the nodes live in one array; the children of a node are adjacent.
  * Build:  median split by COUNT (quickselect on (coordinate, index)) along the
  *         widest axis of the node's bounding box, until a node holds at most
- *         KD_LEAF points. Splitting by count keeps the depth at ceil(log2(n/8))
+ *         KD_LEAF points. Splitting by count keeps the depth at about log2(n/8)
  *         even when all points coincide. O(n log n) time, no extra memory
  *         beyond the copy and the node array.
  * Query:  depth-first, near child first; a far child is visited only if the
@@ -17,7 +17,8 @@
  *         k-th distance. Results are kept sorted by (squared distance, index),
  *         so ties go to the lower index and the answer equals a brute force
  *         that computes dx*dx + dy*dy + dz*dz the same way.
- * Failure modes: n > INT32_MAX (INVALID_ARGUMENT), allocation (OUT_OF_MEMORY).
+ * Failure modes: n >= INT32_MAX or a non-finite coordinate (INVALID_ARGUMENT),
+ *   allocation (OUT_OF_MEMORY). A non-finite query gets 0 neighbours.
  * Queries never allocate and are safe from several threads at once. */
 #include "dacpo_kdtree.h"
 
@@ -25,7 +26,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { KD_LEAF = 12 };
+/* Leaves hold 8..16 points (median splits of a node with more than 16). 12 and
+ * 16 cost the same instructions per 17-NN query; 16 touches fewer nodes. */
+enum { KD_LEAF = 16 };
+
+/* Tree depth bound: n < 2^31 points and leaves of > 8 points give <= 28 levels;
+ * the build checks it, the query's explicit stack relies on it. */
+enum { KD_MAX_DEPTH = 64 };
 
 typedef struct kd_node {
   double low_max;  /* inner: largest coordinate on dim in the left child */
@@ -53,6 +60,7 @@ typedef struct kd_build {
   size_t num_nodes;
   size_t cap_nodes;
   uint64_t rng; /* pivot choice only; fixed seed keeps builds identical */
+  size_t max_depth;
 } kd_build;
 
 static void
@@ -131,17 +139,20 @@ kd_select(kd_build* b, int dim, size_t lo, size_t hi, size_t nth)
     kd_swap(pts, ids, lo, lo + 1);
 }
 
-/* Recursion depth is the tree depth, ceil(log2(n / KD_LEAF)) + 1 <= 29. */
+/* Recursion depth is the tree depth, about log2(n / KD_LEAF) <= 28. */
 static void
-kd_build_node(kd_build* b, size_t node, size_t begin, size_t end)
+kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
 {
   kd_node* nd = &b->nodes[node];
+  if (depth > b->max_depth)
+    b->max_depth = depth;
   nd->begin = (uint32_t)begin;
   nd->end = (uint32_t)end;
   nd->child = -1;
   nd->dim = 0;
   nd->low_max = nd->high_min = 0.0;
-  if (end - begin <= KD_LEAF)
+  /* (the node bound is proven in dacpo_kdtree_build; the check costs nothing) */
+  if (end - begin <= KD_LEAF || b->num_nodes + 2 > b->cap_nodes)
     return;
 
   const double* p = b->pts;
@@ -175,8 +186,8 @@ kd_build_node(kd_build* b, size_t node, size_t begin, size_t end)
   nd->dim = dim;
   nd->low_max = low_max;
   nd->high_min = p[3 * mid + dim];
-  kd_build_node(b, child, begin, mid);
-  kd_build_node(b, child + 1, mid, end);
+  kd_build_node(b, child, begin, mid, depth + 1);
+  kd_build_node(b, child + 1, mid, end, depth + 1);
 }
 
 dacpo_status
@@ -184,9 +195,19 @@ dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* e
 {
   DACPO_CHECK(err, out != NULL, DACPO_ERR_INVALID_ARGUMENT, "kdtree: out is NULL");
   *out = NULL;
-  DACPO_CHECK(err, n == 0 || xyz != NULL, DACPO_ERR_INVALID_ARGUMENT, "kdtree: xyz is NULL");
-  DACPO_CHECK(err, n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "kdtree: %zu points exceed the int32 index range", n);
+  DACPO_CHECK(
+      err, n == 0 || xyz != NULL, DACPO_ERR_INVALID_ARGUMENT, "kdtree: xyz is NULL");
+  DACPO_CHECK(err,
+              n < (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "kdtree: %zu points exceed the int32 index range",
+              n);
+  for (size_t i = 0; i < 3 * n; ++i)
+    DACPO_CHECK(err,
+                isfinite(xyz[i]),
+                DACPO_ERR_INVALID_ARGUMENT,
+                "kdtree: point %zu has a non-finite coordinate",
+                i / 3);
 
   dacpo_kdtree* t = calloc(1, sizeof(*t));
   if (!t)
@@ -209,9 +230,17 @@ dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* e
     t->ids[i] = (int32_t)i;
 
   if (n > 0) {
-    kd_build b = {t->pts, t->ids, t->nodes, 1, cap, 0x9E3779B97F4A7C15ULL};
-    kd_build_node(&b, 0, 0, n);
+    kd_build b = {t->pts, t->ids, t->nodes, 1, cap, 0x9E3779B97F4A7C15ULL, 0};
+    kd_build_node(&b, 0, 0, n, 0);
     t->num_nodes = b.num_nodes;
+    if (b.max_depth >= KD_MAX_DEPTH) {
+      dacpo_kdtree_free(t);
+      return dacpo_err_set(err,
+                           DACPO_ERR_INTERNAL,
+                           "kdtree: depth %zu exceeds %d",
+                           b.max_depth,
+                           (int)KD_MAX_DEPTH);
+    }
   }
   *out = t;
   return DACPO_OK;
@@ -230,17 +259,13 @@ dacpo_kdtree_free(dacpo_kdtree* tree)
 
 /* ---- query ------------------------------------------------------------- */
 
+/* The answer so far, in the caller's arrays: k slots pre-filled with
+ * (+inf, INT32_MAX), so the k-th distance is always d[k - 1]. */
 typedef struct kd_result {
   size_t k, count;
   int32_t* idx;
   double* d;
 } kd_result;
-
-static double
-kd_worst(const kd_result* r)
-{
-  return r->count < r->k ? INFINITY : r->d[r->k - 1];
-}
 
 /* Sorted insertion by (distance, index); k is small (tens), so shifting beats
  * a heap and leaves the output already ordered. */
@@ -248,16 +273,16 @@ static void
 kd_push(kd_result* r, double d, int32_t id)
 {
   size_t pos;
-  if (r->count == r->k) {
-    double wd = r->d[r->k - 1];
-    if (d > wd || (d == wd && id > r->idx[r->k - 1]))
-      return;
-    pos = r->k - 1;
-  }
-  else {
+  if (r->count < r->k) {
     pos = r->count++;
   }
-  while (pos > 0 && (r->d[pos - 1] > d || (r->d[pos - 1] == d && r->idx[pos - 1] > id))) {
+  else {
+    pos = r->k - 1;
+    if (d > r->d[pos] || (d == r->d[pos] && id > r->idx[pos]))
+      return;
+  }
+  while (pos > 0 &&
+         (r->d[pos - 1] > d || (r->d[pos - 1] == d && r->idx[pos - 1] > id))) {
     r->d[pos] = r->d[pos - 1];
     r->idx[pos] = r->idx[pos - 1];
     --pos;
@@ -266,47 +291,87 @@ kd_push(kd_result* r, double d, int32_t id)
   r->idx[pos] = id;
 }
 
-/* off[d] is a lower bound of |q[d] - p[d]| for every point p of the node.
- * Squares and sums are formed exactly as for a point's distance, and rounding
- * is monotone, so the bound never exceeds a computed point distance: pruning
- * with "bound > k-th distance" cannot lose a tie. */
+/* A subtree left for later: its node and the per-axis offsets (off[d] is a
+ * lower bound of |q[d] - p[d]| for every point p below the node). */
+typedef struct kd_pending {
+  size_t node;
+  double off[3];
+} kd_pending;
+
+/* Depth-first, near child first, with an explicit stack (at most one pending
+ * entry per tree level). A pending subtree is entered only if its bound, formed
+ * exactly like a point's squared distance, is <= the current k-th distance;
+ * rounding is monotone, so the bound never exceeds a computed point distance
+ * and pruning cannot lose a tie. */
 static void
-kd_search(const dacpo_kdtree* t, size_t node, const double q[3], double off[3], kd_result* r)
+kd_search(const dacpo_kdtree* t, const double q[3], kd_result* r)
 {
-  const kd_node* nd = &t->nodes[node];
-  if (nd->child < 0) {
-    const double* p = t->pts;
-    for (uint32_t i = nd->begin; i < nd->end; ++i) {
-      double dx = q[0] - p[3 * i], dy = q[1] - p[3 * i + 1], dz = q[2] - p[3 * i + 2];
-      double d = dx * dx + dy * dy + dz * dz;
-      if (d <= kd_worst(r))
-        kd_push(r, d, t->ids[i]);
+  /* copies: r's arrays are doubles too, so q would be reloaded after pushes */
+  const double q0 = q[0], q1 = q[1], q2 = q[2];
+  kd_pending stack[KD_MAX_DEPTH];
+  size_t top = 0;
+  size_t node = 0;
+  double off[3] = {0.0, 0.0, 0.0};
+  for (;;) {
+    const kd_node* nd = &t->nodes[node];
+    if (nd->child >= 0) {
+      int dim = nd->dim;
+      double qd = dim == 0 ? q0 : (dim == 1 ? q1 : q2);
+      double to_low = qd - nd->low_max;   /* >= 0 when q is right of the left child */
+      double to_high = nd->high_min - qd; /* >= 0 when q is left of the right child */
+      kd_pending* pd = &stack[top++];
+      pd->off[0] = off[0];
+      pd->off[1] = off[1];
+      pd->off[2] = off[2];
+      double far_off;
+      if (to_low < to_high) {
+        node = (size_t)nd->child;
+        pd->node = node + 1;
+        far_off = to_high;
+      }
+      else {
+        pd->node = (size_t)nd->child;
+        node = pd->node + 1;
+        far_off = to_low;
+      }
+      if (far_off > off[dim])
+        pd->off[dim] = far_off;
+      continue;
     }
-    return;
+    const double* p = t->pts + 3 * (size_t)nd->begin;
+    const int32_t* ids = t->ids + nd->begin;
+    uint32_t m = nd->end - nd->begin;
+    double worst = r->d[r->k - 1];
+    for (uint32_t i = 0; i < m; ++i, p += 3) {
+      double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+      double d = dx * dx + dy * dy + dz * dz;
+      if (d <= worst) {
+        kd_push(r, d, ids[i]);
+        worst = r->d[r->k - 1];
+      }
+    }
+    /* resume at the deepest pending subtree that may still hold a closer point */
+    for (;;) {
+      if (top == 0)
+        return;
+      const kd_pending* pd = &stack[--top];
+      double bound =
+          pd->off[0] * pd->off[0] + pd->off[1] * pd->off[1] + pd->off[2] * pd->off[2];
+      if (bound <= r->d[r->k - 1]) {
+        node = pd->node;
+        off[0] = pd->off[0];
+        off[1] = pd->off[1];
+        off[2] = pd->off[2];
+        break;
+      }
+    }
   }
-  int dim = nd->dim;
-  double to_low = q[dim] - nd->low_max;   /* >= 0 when q is right of the left child */
-  double to_high = nd->high_min - q[dim]; /* >= 0 when q is left of the right child */
-  size_t near, far;
-  double far_off;
-  if (to_low < to_high) {
-    near = (size_t)nd->child;
-    far = near + 1;
-    far_off = to_high;
-  }
-  else {
-    far = (size_t)nd->child;
-    near = far + 1;
-    far_off = to_low;
-  }
-  kd_search(t, near, q, off, r);
-  double saved = off[dim];
-  if (far_off > saved)
-    off[dim] = far_off;
-  double bound = off[0] * off[0] + off[1] * off[1] + off[2] * off[2];
-  if (bound <= kd_worst(r))
-    kd_search(t, far, q, off, r);
-  off[dim] = saved;
+}
+
+const int32_t*
+dacpo_kdtree_order(const dacpo_kdtree* tree)
+{
+  return tree && tree->n > 0 ? tree->ids : NULL;
 }
 
 size_t
@@ -318,8 +383,17 @@ dacpo_kdtree_knn(const dacpo_kdtree* tree,
 {
   if (!tree || tree->n == 0 || k == 0 || !q || !idx || !sq_dist)
     return 0;
-  kd_result r = {k < tree->n ? k : tree->n, 0, idx, sq_dist};
-  double off[3] = {0.0, 0.0, 0.0};
-  kd_search(tree, 0, q, off, &r);
+  if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2]))
+    return 0;
+  if (k > tree->n)
+    k = tree->n;
+  for (size_t j = 0; j < k; ++j) {
+    idx[j] = INT32_MAX;
+    sq_dist[j] = INFINITY;
+  }
+  kd_result r = {k, 0, idx, sq_dist};
+  kd_search(tree, q, &r);
+  /* Nothing is pruned while a slot is empty (its bound is +inf), so all
+   * k <= n slots are filled. */
   return r.count;
 }

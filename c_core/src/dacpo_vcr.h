@@ -7,11 +7,27 @@
 #include "dacpo_internal.h"
 
 typedef struct dacpo_vcr_params {
-  size_t image_size;       /* 400 */
-  size_t num_views;        /* 12 (dodecahedron face centres) */
-  int perspective;         /* 0 orthographic, 1 perspective */
-  int boundary_factor;     /* 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 */
+  size_t image_size;   /* 400 */
+  size_t num_views;    /* 12 (dodecahedron face centres) */
+  int perspective;     /* 0 orthographic, 1 perspective */
+  int boundary_factor; /* 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 */
+  /* Added by stage 4 (appended; defaults from dacpo_vcr_params_default): */
+  size_t gap_fill;       /* 2: empty pixels within this many 4-steps of a drawn pixel
+                            take the nearest neighbour's depth and triangle, so a seam
+                            of up to 2*gap_fill pixels between the two meshes still
+                            joins them; 0 = off */
+  int drop_partial;      /* 0; 1: remove the pixels of triangles that are only partly
+                            visible (paper Fig. "VCR" (b, e)) */
+  int eta_all;           /* 0: eta = largest depth span of the triangles that own at
+                            least one pixel; 1: of all triangles (paper's formula) */
+  double gap_fill_edges; /* 0.75: per view, the seam closing reaches at least
+                            this many median triangle edges (converted to pixels,
+                            at most DACPO_VCR_GAP_MAX): block meshes cut face by
+                            face leave seams about one face wide; 0 = off */
 } dacpo_vcr_params;
+
+/* Upper bound (pixels) of the seam closing chosen by gap_fill_edges. */
+#define DACPO_VCR_GAP_MAX 8
 
 void
 dacpo_vcr_params_default(dacpo_vcr_params* p);
@@ -25,5 +41,66 @@ dacpo_vcr_edge(const dacpo_mesh* a,
                double* alpha,
                double* alpha_bar,
                dacpo_err* err);
+
+/* ---- additions (stage 4) ------------------------------------------------ */
+
+/* The epsilon of paper Eq. 7 for alpha values as dacpo_vcr_edge scales them
+ * (pixel counts divided by image_size^2, boundary counts by image_size; one
+ * boundary pixel between two one-pixel regions is ~1e-13 at 400 x 400). */
+#define DACPO_VCR_EPSILON 1e-15
+
+/* Paper Eq. 7: w_same = alpha / (alpha + alpha_bar + eps), w_differ =
+ * alpha_bar / (alpha + alpha_bar + eps). Both 0 when the edge carries no
+ * evidence. NULL outputs are skipped. */
+void
+dacpo_vcr_omega(
+    double alpha, double alpha_bar, double eps, double* w_same, double* w_differ);
+
+/* Unit view directions used for num_views views (the camera looks along them):
+ * num_views <= 12: the first num_views of the 12 icosahedron vertex directions
+ * (= dodecahedron face centres), ordered so that the first 6 are one of each
+ * antipodal pair and the last 6 their opposites; num_views > 12: a Fibonacci
+ * sphere. dirs holds 3 * num_views doubles. */
+void
+dacpo_vcr_view_directions(size_t num_views, double* dirs);
+
+/* What one view contributed (diagnostics). */
+typedef struct dacpo_vcr_view_stats {
+  double direction[3]; /* the camera looks along it */
+  double eta;          /* depth threshold of this view (0 if nothing drawn) */
+  size_t pixels_a;     /* pixels won by mesh a / b after the z-test (and gap fill) */
+  size_t pixels_b;
+  size_t cross_same; /* depth-continuous 4-neighbour pixel pairs across the two */
+  size_t cross_diff; /* meshes whose facing agrees / differs (as given) */
+  size_t regions;    /* sub-regions holding both meshes: as given / b inverted */
+  size_t regions_bar;
+  double alpha; /* this view's share of alpha / alpha_bar */
+  double alpha_bar;
+  size_t gap_pixels; /* seam-closing radius used in this view */
+} dacpo_vcr_view_stats;
+
+/* Label codes written to dacpo_vcr_edge_debug's images. */
+#define DACPO_VCR_PIXEL_EMPTY 0
+#define DACPO_VCR_PIXEL_A_FRONT 1 /* mesh a, face normal towards the camera */
+#define DACPO_VCR_PIXEL_A_BACK 2
+#define DACPO_VCR_PIXEL_B_FRONT 3
+#define DACPO_VCR_PIXEL_B_BACK 4
+#define DACPO_VCR_PIXEL_BOUNDARY                                                       \
+  8 /* or-ed in: has a depth-continuous                                                \
+       4-neighbour of the other mesh */
+
+/* dacpo_vcr_edge plus, optionally, per-view statistics (views: NULL or
+ * params->num_views entries) and label images (images: NULL or num_views *
+ * image_size * image_size bytes, row-major, codes above; views that draw
+ * nothing stay 0). alpha/alpha_bar may be NULL here. */
+dacpo_status
+dacpo_vcr_edge_debug(const dacpo_mesh* a,
+                     const dacpo_mesh* b,
+                     const dacpo_vcr_params* params,
+                     double* alpha,
+                     double* alpha_bar,
+                     dacpo_vcr_view_stats* views,
+                     uint8_t* images,
+                     dacpo_err* err);
 
 #endif

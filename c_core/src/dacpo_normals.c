@@ -1,0 +1,219 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 0, normals: PCA normal axes when the caller gives none (paper §4.2
+ * starts from unoriented normals "estimated by PCA", Hoppe et al. 1992).
+ *
+ * For each distinct point p: C = sum (x - m)(x - m)^T over x in {p} and its first
+ * normal_k neighbours, m their mean (centring first keeps precision for clouds
+ * far from the origin). The axis is the eigenvector of C's smallest eigenvalue
+ * l0; the surface variation l0 / (l0 + l1 + l2) (Pauly et al. 2002) is the
+ * curvature reported to PCL users.
+ * Eigen-solver: cyclic Jacobi on the 3x3 matrix scaled to max |c_ij| = 1. It
+ * always returns an orthonormal basis, so coincident or collinear neighbourhoods
+ * still yield a unit vector (its direction is then arbitrary but deterministic),
+ * never NaN.
+ * Cost: O(n normal_k), parallel over chunks of points.
+ * Failure modes: bad arguments (INVALID_ARGUMENT); nothing else. */
+#include "dacpo_normals.h"
+
+#include "dacpo_parallel.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { NORMALS_CHUNK = 4096, JACOBI_MAX_SWEEPS = 50 };
+
+/* Eigen-decomposition of a symmetric 3x3 matrix a (destroyed): eigenvalues in
+ * w, eigenvectors in the columns of v (v[row][col]), unsorted. */
+static void
+jacobi3(double a[3][3], double w[3], double v[3][3])
+{
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      v[i][j] = i == j ? 1.0 : 0.0;
+  double fro = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      fro += a[i][j] * a[i][j];
+  static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int sweep = 0; sweep < JACOBI_MAX_SWEEPS; ++sweep) {
+    double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    /* off-diagonal at rounding level of the whole matrix: converged */
+    if (off <= 1e-34 * fro)
+      break;
+    for (int r = 0; r < 3; ++r) {
+      int p = pairs[r][0], q = pairs[r][1];
+      double apq = a[p][q];
+      if (apq == 0.0)
+        continue;
+      /* Rotation that zeroes a[p][q]: t = tan(phi) is the smaller root of
+       * t^2 + 2 t theta - 1 = 0, which keeps the rotation angle <= pi/4. */
+      double theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+      double t;
+      if (fabs(theta) > 1e150)
+        t = 0.5 / theta;
+      else
+        t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+      double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+      a[p][p] -= t * apq;
+      a[q][q] += t * apq;
+      a[p][q] = a[q][p] = 0.0;
+      int o = 3 - p - q; /* the remaining index */
+      double aop = a[o][p], aoq = a[o][q];
+      a[o][p] = a[p][o] = c * aop - s * aoq;
+      a[o][q] = a[q][o] = s * aop + c * aoq;
+      for (int i = 0; i < 3; ++i) {
+        double vip = v[i][p], viq = v[i][q];
+        v[i][p] = c * vip - s * viq;
+        v[i][q] = s * vip + c * viq;
+      }
+    }
+  }
+  for (int i = 0; i < 3; ++i)
+    w[i] = a[i][i];
+}
+
+/* PCA axis and surface variation of one neighbourhood. */
+static void
+pca_point(const dacpo_cloud* cloud,
+          const dacpo_knn_graph* g,
+          size_t normal_k,
+          size_t i,
+          double nrm[3],
+          double* curv)
+{
+  const double* xyz = cloud->xyz;
+  const int32_t* row = g->idx + i * g->k;
+  double m[3] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+  size_t cnt = 1;
+  for (size_t j = 0; j < normal_k; ++j) {
+    int32_t v = row[j];
+    if (v < 0 || (size_t)v >= cloud->n)
+      continue;
+    for (int d = 0; d < 3; ++d)
+      m[d] += xyz[3 * (size_t)v + d];
+    ++cnt;
+  }
+  for (int d = 0; d < 3; ++d)
+    m[d] /= (double)cnt;
+
+  double c[3][3] = {{0.0}};
+  for (size_t j = 0; j <= normal_k; ++j) {
+    size_t p;
+    if (j == 0) {
+      p = i;
+    }
+    else {
+      int32_t v = row[j - 1];
+      if (v < 0 || (size_t)v >= cloud->n)
+        continue;
+      p = (size_t)v;
+    }
+    double e[3] = {xyz[3 * p] - m[0], xyz[3 * p + 1] - m[1], xyz[3 * p + 2] - m[2]};
+    for (int r = 0; r < 3; ++r)
+      for (int s = r; s < 3; ++s)
+        c[r][s] += e[r] * e[s];
+  }
+  c[1][0] = c[0][1];
+  c[2][0] = c[0][2];
+  c[2][1] = c[1][2];
+
+  /* Scale to max |c_ij| = 1 so tiny or huge neighbourhoods neither underflow
+   * nor overflow inside Jacobi; eigenvectors and l0/trace are scale-free. */
+  double mx = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int s = 0; s < 3; ++s)
+      if (fabs(c[r][s]) > mx)
+        mx = fabs(c[r][s]);
+  double w[3] = {0.0, 0.0, 0.0};
+  double v[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+  if (mx > 0.0 && isfinite(mx)) {
+    for (int r = 0; r < 3; ++r)
+      for (int s = 0; s < 3; ++s)
+        c[r][s] /= mx;
+    jacobi3(c, w, v);
+  }
+  int lo = 0;
+  for (int d = 1; d < 3; ++d)
+    if (w[d] < w[lo])
+      lo = d;
+  double len = sqrt(v[0][lo] * v[0][lo] + v[1][lo] * v[1][lo] + v[2][lo] * v[2][lo]);
+  if (len > 0.0 && isfinite(len)) {
+    for (int d = 0; d < 3; ++d)
+      nrm[d] = v[d][lo] / len;
+  }
+  else {
+    nrm[0] = 0.0;
+    nrm[1] = 0.0;
+    nrm[2] = 1.0;
+  }
+  /* covariance is positive semi-definite; clamp rounding below zero */
+  double l[3], trace = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    l[d] = w[d] > 0.0 ? w[d] : 0.0;
+    trace += l[d];
+  }
+  *curv = trace > 0.0 ? l[lo] / trace : 0.0;
+}
+
+typedef struct normals_job {
+  const dacpo_cloud* cloud;
+  const dacpo_knn_graph* g;
+  size_t normal_k;
+  double* nrm;
+  float* curvature;
+} normals_job;
+
+static dacpo_status
+normals_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
+{
+  (void)thread_id;
+  (void)err;
+  const normals_job* job = user;
+  size_t n = job->cloud->n;
+  size_t begin = task * NORMALS_CHUNK;
+  size_t end = begin + NORMALS_CHUNK < n ? begin + NORMALS_CHUNK : n;
+  for (size_t i = begin; i < end; ++i) {
+    double curv;
+    pca_point(job->cloud, job->g, job->normal_k, i, job->nrm + 3 * i, &curv);
+    if (job->curvature)
+      job->curvature[i] = (float)curv;
+  }
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_normals_pca(const dacpo_cloud* cloud,
+                  const dacpo_knn_graph* g,
+                  size_t normal_k,
+                  unsigned num_threads,
+                  double* nrm_out,
+                  float* curvature,
+                  dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              cloud != NULL && g != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "normals: cloud or graph is NULL");
+  DACPO_CHECK(err,
+              g->n == cloud->n,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "normals: graph has %zu points, cloud has %zu",
+              g->n,
+              cloud->n);
+  DACPO_CHECK(err,
+              normal_k <= g->k,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "normals: normal_k = %zu exceeds the graph's k = %zu",
+              normal_k,
+              g->k);
+  if (cloud->n == 0)
+    return DACPO_OK;
+  DACPO_CHECK(err,
+              nrm_out != NULL && cloud->xyz != NULL && (g->k == 0 || g->idx != NULL),
+              DACPO_ERR_INVALID_ARGUMENT,
+              "normals: NULL array");
+  normals_job job = {cloud, g, normal_k, nrm_out, curvature};
+  size_t tasks = (cloud->n + NORMALS_CHUNK - 1) / NORMALS_CHUNK;
+  return dacpo_parallel_for(
+      tasks, num_threads, normals_task, &job, NULL, DACPO_STAGE_NORMALS, err);
+}

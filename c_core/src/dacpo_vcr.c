@@ -1,0 +1,834 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 4b: visible connected regions (VCR) between two adjacent blocks
+ * (paper §5.1 "Visible Connected Regions" and "Orientation Consistency
+ * Evaluation", Eq. 6-7; ALGORITHM.md §4).
+ *
+ * In:  the trimmed meshes a and b of two adjacent blocks (face normal
+ *      (v1-v0)x(v2-v0) agrees with the block's oriented normals), parameters.
+ * Out: alpha  = sum over views j and sub-regions k of I(V_k^{S_j}) (Eq. 6) with
+ *               both meshes as given;
+ *      alpha_bar = the same with mesh b's facing inverted.
+ *
+ * Per view (12 directions = dodecahedron face centres around the centre of the
+ * pair's bounding box):
+ *  1. project every used vertex (orthographic, or a pinhole camera at distance
+ *     2R from the centre) and fit the projection into image_size^2 square pixels;
+ *  2. rasterize all triangles of both meshes once into one z-buffer (exact
+ *     coverage, interpolated depth; dacpo_raster.c);
+ *  3. eta = largest depth span max D(v) - min D(v) of a triangle that owns at
+ *     least one pixel (params->eta_all: of every triangle, the paper's formula);
+ *     optional removal of partly visible triangles; seam closing: empty pixels
+ *     within r = max(gap_fill, gap_fill_edges * median edge) pixels of drawn ones
+ *     copy the nearest (two block meshes cut face by face meet with seams about
+ *     one face wide, which would otherwise cut every VCR at the block boundary);
+ *  4. one union-find pass over 4-neighbour pixel pairs joins pixels of the SAME
+ *     mesh with |depth difference| <= eta (+ a float tolerance) and equal facing
+ *     into "atoms". Facing within one mesh does not change when b is inverted,
+ *     so atoms serve both labellings; a depth-continuous pair across the two
+ *     meshes joins its atoms as given if the facings agree, and with b inverted
+ *     if they differ. Each labelling's components of atoms are the view-aligned
+ *     sub-regions of the VCRs (the VCR split by facing) in one pass;
+ *  5. per sub-region C1, C2 = pixels of a, b; C_B = boundary pixels: pixels with
+ *     a 4-neighbour of the other mesh in the SAME sub-region (depth-continuous
+ *     and of equal facing under that labelling); I = C_B*C1*C2 (or C1*C2).
+ * Counts are scaled (C1, C2 by 1/image_size^2, C_B by 1/image_size) so alpha does
+ * not depend on the image size; omega (Eq. 7) is scale-free anyway.
+ *
+ * Cost: O(V + T + image area) per view; ~2 x 5K triangles, 12 views, 400^2:
+ * see bench_vcr.c. Scratch (~50 bytes per pixel) is allocated per call; no
+ * global state, so edges can run on several threads at once.
+ * Failures: bad parameters, out-of-range indices or non-finite vertices
+ * (DACPO_ERR_INVALID_ARGUMENT), allocation (DACPO_ERR_OUT_OF_MEMORY). Empty
+ * meshes or degenerate geometry give alpha = alpha_bar = 0 and DACPO_OK. */
+#include "dacpo_vcr.h"
+
+#include "dacpo_raster.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define VCR_MAX_IMAGE 4096
+#define VCR_MAX_VIEWS 10000
+
+/* per-pixel flags of pass 4 */
+#define PF_SAME 1u      /* has a depth-continuous cross neighbour, equal facing */
+#define PF_DIFF 2u      /* ... with different facing */
+#define PF_LEFT_X 4u    /* cross pair with the left neighbour */
+#define PF_LEFT_SAME 8u /* ... and its facing agrees */
+#define PF_UP_X 16u
+#define PF_UP_SAME 32u
+
+void
+dacpo_vcr_params_default(dacpo_vcr_params* p)
+{
+  if (p == NULL)
+    return;
+  memset(p, 0, sizeof(*p));
+  p->image_size = 400;
+  p->num_views = 12;
+  p->perspective = 0;
+  p->boundary_factor = 1;
+  p->gap_fill = 2;
+  p->gap_fill_edges = 0.75;
+  p->drop_partial = 0;
+  p->eta_all = 0;
+}
+
+void
+dacpo_vcr_omega(
+    double alpha, double alpha_bar, double eps, double* w_same, double* w_differ)
+{
+  double den = alpha + alpha_bar + eps;
+  double s = 0.0, d = 0.0;
+  if (den > 0.0 && isfinite(den)) {
+    s = alpha / den;
+    d = alpha_bar / den;
+  }
+  if (w_same != NULL)
+    *w_same = s;
+  if (w_differ != NULL)
+    *w_differ = d;
+}
+
+void
+dacpo_vcr_view_directions(size_t num_views, double* dirs)
+{
+  if (dirs == NULL)
+    return;
+  if (num_views <= 12) {
+    /* Icosahedron vertices (0, ±1, ±phi) and cyclic permutations; one of each
+     * antipodal pair first, so that 6 views still cover 6 distinct axes. */
+    const double phi = (1.0 + sqrt(5.0)) / 2.0;
+    const double half[6][3] = {{0, 1, phi},
+                               {0, -1, phi},
+                               {1, phi, 0},
+                               {-1, phi, 0},
+                               {phi, 0, 1},
+                               {phi, 0, -1}};
+    double norm = sqrt(1.0 + phi * phi);
+    for (size_t i = 0; i < num_views; ++i) {
+      double sign = i < 6 ? 1.0 : -1.0;
+      for (int k = 0; k < 3; ++k)
+        dirs[3 * i + (size_t)k] = sign * half[i % 6][k] / norm;
+    }
+    return;
+  }
+  const double golden = 3.14159265358979323846 * (3.0 - sqrt(5.0));
+  for (size_t i = 0; i < num_views; ++i) {
+    double z = 1.0 - (2.0 * (double)i + 1.0) / (double)num_views;
+    double r = sqrt(fmax(0.0, 1.0 - z * z));
+    double ang = golden * (double)i;
+    dirs[3 * i + 0] = r * cos(ang);
+    dirs[3 * i + 1] = r * sin(ang);
+    dirs[3 * i + 2] = z;
+  }
+}
+
+typedef struct vcr_work {
+  size_t N;        /* image side */
+  size_t na_t, nt; /* triangles of a, of a + b */
+  size_t na_v, nv; /* vertices of a, of a + b */
+  double edge_len; /* median triangle edge length (sampled) */
+  const dacpo_mesh* m[2];
+  dacpo_raster r;
+  double* tri_normal; /* 3 * nt: (v1-v0)x(v2-v0) */
+  double* tri_centre; /* 3 * nt (perspective facing) */
+  uint8_t* used;      /* nv: vertex referenced by a triangle */
+  double* scr;        /* 3 * nv: pixel x, y, screen-linear z */
+  double* vdepth;     /* nv: depth along the view direction */
+  uint8_t* back;      /* nt: 1 if the face normal points away from the camera */
+  int32_t* covered;   /* nt: pixel centres covered (drop_partial) */
+  int32_t* owned;     /* nt: pixels won */
+  int32_t* parent;    /* N^2: pixel union-find */
+  uint8_t* cls;       /* N^2: 0 empty, else 1 + 2 * mesh + back */
+  int32_t* atom;      /* N^2: compact atom id */
+  uint8_t* flags;     /* N^2 */
+  /* per atom (at most N^2) */
+  uint8_t* a_blk;
+  int32_t* a_cnt;
+  int32_t* a_cbs;
+  int32_t* a_cbd;
+  int32_t* a_par[2];
+  int32_t* acc_c1;
+  int32_t* acc_c2;
+  int32_t* acc_cb;
+} vcr_work;
+
+static void
+work_free(vcr_work* w)
+{
+  dacpo_raster_free(&w->r);
+  free(w->tri_normal);
+  free(w->tri_centre);
+  free(w->used);
+  free(w->scr);
+  free(w->vdepth);
+  free(w->back);
+  free(w->covered);
+  free(w->owned);
+  free(w->parent);
+  free(w->cls);
+  free(w->atom);
+  free(w->flags);
+  free(w->a_blk);
+  free(w->a_cnt);
+  free(w->a_cbs);
+  free(w->a_cbd);
+  free(w->a_par[0]);
+  free(w->a_par[1]);
+  free(w->acc_c1);
+  free(w->acc_c2);
+  free(w->acc_cb);
+  memset(w, 0, sizeof(*w));
+}
+
+static const double*
+vertex_of(const vcr_work* w, size_t gv)
+{
+  return gv < w->na_v ? &w->m[0]->vertices[3 * gv]
+                      : &w->m[1]->vertices[3 * (gv - w->na_v)];
+}
+
+/* Global vertex index of corner k of global triangle t. */
+static size_t
+corner(const vcr_work* w, size_t t, int k)
+{
+  if (t < w->na_t)
+    return (size_t)w->m[0]->triangles[3 * t + (size_t)k];
+  return w->na_v + (size_t)w->m[1]->triangles[3 * (t - w->na_t) + (size_t)k];
+}
+
+static dacpo_status
+check_mesh(const dacpo_mesh* m, const char* name, dacpo_err* err)
+{
+  DACPO_CHECK(err, m != NULL, DACPO_ERR_INVALID_ARGUMENT, "vcr: mesh %s is NULL", name);
+  if (m->num_triangles == 0)
+    return DACPO_OK;
+  DACPO_CHECK(err,
+              m->triangles != NULL && m->vertices != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: mesh %s has %zu triangles but NULL arrays",
+              name,
+              m->num_triangles);
+  DACPO_CHECK(err,
+              m->num_vertices < (size_t)INT32_MAX &&
+                  m->num_triangles < (size_t)INT32_MAX / 2,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: mesh %s too large (%zu vertices, %zu triangles)",
+              name,
+              m->num_vertices,
+              m->num_triangles);
+  for (size_t i = 0; i < 3 * m->num_triangles; ++i) {
+    int32_t v = m->triangles[i];
+    DACPO_CHECK(err,
+                v >= 0 && (size_t)v < m->num_vertices,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "vcr: mesh %s triangle %zu refers to vertex %d (mesh has %zu)",
+                name,
+                i / 3,
+                (int)v,
+                m->num_vertices);
+    const double* p = &m->vertices[3 * (size_t)v];
+    DACPO_CHECK(err,
+                isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]),
+                DACPO_ERR_INVALID_ARGUMENT,
+                "vcr: mesh %s vertex %d is not finite",
+                name,
+                (int)v);
+  }
+  return DACPO_OK;
+}
+
+static int32_t
+uf_find(int32_t* parent, int32_t x)
+{
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]]; /* path halving */
+    x = parent[x];
+  }
+  return x;
+}
+
+/* The smaller index becomes the root: a root then precedes every member in scan
+ * order, which lets one scan hand out compact ids. */
+static void
+uf_union(int32_t* parent, int32_t x, int32_t y)
+{
+  x = uf_find(parent, x);
+  y = uf_find(parent, y);
+  if (x < y)
+    parent[y] = x;
+  else if (y < x)
+    parent[x] = y;
+}
+
+static dacpo_status
+work_alloc(vcr_work* w, dacpo_err* err)
+{
+  size_t npix = w->N * w->N;
+  DACPO_TRY(dacpo_raster_init(&w->r, w->N, w->N, err));
+  w->tri_normal = (double*)dacpo_malloc_array(3 * w->nt, sizeof(double));
+  w->tri_centre = (double*)dacpo_malloc_array(3 * w->nt, sizeof(double));
+  w->used = (uint8_t*)dacpo_calloc_array(w->nv, 1);
+  w->scr = (double*)dacpo_malloc_array(3 * w->nv, sizeof(double));
+  w->vdepth = (double*)dacpo_malloc_array(w->nv, sizeof(double));
+  w->back = (uint8_t*)dacpo_malloc_array(w->nt, 1);
+  w->covered = (int32_t*)dacpo_malloc_array(w->nt, sizeof(int32_t));
+  w->owned = (int32_t*)dacpo_malloc_array(w->nt, sizeof(int32_t));
+  w->parent = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->atom = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->cls = (uint8_t*)dacpo_malloc_array(npix, 1);
+  w->flags = (uint8_t*)dacpo_calloc_array(npix, 1);
+  w->a_blk = (uint8_t*)dacpo_malloc_array(npix, 1);
+  w->a_cnt = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->a_cbs = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->a_cbd = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->a_par[0] = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->a_par[1] = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->acc_c1 = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->acc_c2 = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  w->acc_cb = (int32_t*)dacpo_malloc_array(npix, sizeof(int32_t));
+  if (!w->tri_normal || !w->tri_centre || !w->used || !w->scr || !w->vdepth ||
+      !w->back || !w->covered || !w->owned || !w->parent || !w->cls || !w->atom ||
+      !w->flags || !w->a_blk || !w->a_cnt || !w->a_cbs || !w->a_cbd || !w->a_par[0] ||
+      !w->a_par[1] || !w->acc_c1 || !w->acc_c2 || !w->acc_cb)
+    return DACPO_OOM(err);
+  return DACPO_OK;
+}
+
+typedef struct view_result {
+  double alpha, alpha_bar, eta;
+  size_t gap;
+  size_t pix[2], cross_same, cross_diff, regions[2];
+} view_result;
+
+static int
+cmp_double(const void* x, const void* y)
+{
+  double a = *(const double*)x, b = *(const double*)y;
+  return (a > b) - (a < b);
+}
+
+/* Median edge length over an even sample of at most 341 triangles (1023 edges):
+ * the scale of a face, hence of the seams between two meshes cut face by face. */
+static double
+median_edge_length(const vcr_work* w)
+{
+  double len[1023];
+  size_t stride = w->nt / 341 + 1, n = 0;
+  for (size_t t = 0; t < w->nt && n + 3 <= 1023; t += stride)
+    for (int k = 0; k < 3; ++k) {
+      const double* p = vertex_of(w, corner(w, t, k));
+      const double* q = vertex_of(w, corner(w, t, (k + 1) % 3));
+      double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+      len[n++] = sqrt(dx * dx + dy * dy + dz * dz);
+    }
+  if (n == 0)
+    return 0.0;
+  qsort(len, n, sizeof(double), cmp_double);
+  return len[n / 2];
+}
+
+static void
+orthonormal_basis(const double d[3], double u[3], double v[3])
+{
+  /* helper axis: the one least aligned with d */
+  double h[3] = {0, 0, 0};
+  double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
+  if (ax <= ay && ax <= az)
+    h[0] = 1;
+  else if (ay <= az)
+    h[1] = 1;
+  else
+    h[2] = 1;
+  u[0] = d[1] * h[2] - d[2] * h[1];
+  u[1] = d[2] * h[0] - d[0] * h[2];
+  u[2] = d[0] * h[1] - d[1] * h[0];
+  double n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  u[0] /= n;
+  u[1] /= n;
+  u[2] /= n;
+  v[0] = d[1] * u[2] - d[2] * u[1];
+  v[1] = d[2] * u[0] - d[0] * u[2];
+  v[2] = d[0] * u[1] - d[1] * u[0];
+}
+
+/* One view: steps 1-5 of the file comment. Returns 0 contributions when the
+ * projection is degenerate. images: NULL or N*N bytes. */
+static void
+run_view(vcr_work* w,
+         const dacpo_vcr_params* prm,
+         const double centre[3],
+         double radius,
+         const double d[3],
+         view_result* res,
+         uint8_t* image)
+{
+  memset(res, 0, sizeof(*res));
+  const size_t N = w->N;
+  const int persp = prm->perspective != 0;
+  double u[3], v[3];
+  orthonormal_basis(d, u, v);
+  double eye[3] = {0, 0, 0};
+  double dist = 2.0 * radius;
+  if (persp)
+    for (int k = 0; k < 3; ++k)
+      eye[k] = centre[k] - dist * d[k];
+  const double* origin = persp ? eye : centre;
+
+  /* 1. project the used vertices and fit their 2D bounding box */
+  double minx = INFINITY, maxx = -INFINITY, miny = INFINITY, maxy = -INFINITY;
+  for (size_t i = 0; i < w->nv; ++i) {
+    if (!w->used[i])
+      continue;
+    const double* p = vertex_of(w, i);
+    double r[3] = {p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]};
+    double x = r[0] * u[0] + r[1] * u[1] + r[2] * u[2];
+    double y = r[0] * v[0] + r[1] * v[1] + r[2] * v[2];
+    double z = r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
+    if (persp) {
+      /* z >= dist - radius = radius > 0: every vertex is in front of the camera */
+      x /= z;
+      y /= z;
+    }
+    w->scr[3 * i + 0] = x;
+    w->scr[3 * i + 1] = y;
+    w->scr[3 * i + 2] = z;
+    w->vdepth[i] = z;
+    minx = x < minx ? x : minx;
+    maxx = x > maxx ? x : maxx;
+    miny = y < miny ? y : miny;
+    maxy = y > maxy ? y : maxy;
+  }
+  double ext = fmax(maxx - minx, maxy - miny);
+  double rel = persp ? ext : ext / radius; /* perspective coords are already angles */
+  if (!(rel > 1e-9) || !isfinite(ext))
+    return;
+  double margin = 1.0 + (double)prm->gap_fill;
+  double scale = ((double)N - 2.0 * margin) / ext;
+  /* seam closing radius: gap_fill pixels, or gap_fill_edges median edges */
+  size_t gap = prm->gap_fill;
+  if (prm->gap_fill_edges > 0.0) {
+    double px_per_unit = persp ? scale / dist : scale; /* at the centre's depth */
+    double want = ceil(prm->gap_fill_edges * w->edge_len * px_per_unit);
+    if (want > (double)DACPO_VCR_GAP_MAX)
+      want = (double)DACPO_VCR_GAP_MAX;
+    if (want > (double)gap)
+      gap = (size_t)want;
+  }
+  res->gap = gap;
+  double cx = 0.5 * (minx + maxx), cy = 0.5 * (miny + maxy);
+  for (size_t i = 0; i < w->nv; ++i) {
+    if (!w->used[i])
+      continue;
+    w->scr[3 * i + 0] = 0.5 * (double)N + (w->scr[3 * i + 0] - cx) * scale;
+    w->scr[3 * i + 1] = 0.5 * (double)N + (w->scr[3 * i + 1] - cy) * scale;
+    /* 1/depth is linear in screen space under a pinhole projection */
+    if (persp)
+      w->scr[3 * i + 2] = -1.0 / w->scr[3 * i + 2];
+  }
+
+  /* 2. facing and rasterization (a first, then b: exact depth ties keep a) */
+  for (size_t t = 0; t < w->nt; ++t) {
+    const double* n = &w->tri_normal[3 * t];
+    double s;
+    if (persp) {
+      const double* c = &w->tri_centre[3 * t];
+      s = (c[0] - eye[0]) * n[0] + (c[1] - eye[1]) * n[1] + (c[2] - eye[2]) * n[2];
+    }
+    else
+      s = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    w->back[t] = s > 0.0 ? 1 : 0;
+    size_t i0 = corner(w, t, 0), i1 = corner(w, t, 1), i2 = corner(w, t, 2);
+    w->covered[t] = (int32_t)dacpo_raster_triangle(
+        &w->r, &w->scr[3 * i0], &w->scr[3 * i1], &w->scr[3 * i2], (int32_t)t);
+    w->owned[t] = 0;
+  }
+  dacpo_raster* R = &w->r;
+  if (R->x0 > R->x1)
+    return;
+  /* cls: 1 = drawn, 0 = empty (for the seam closing; pass 4 overwrites it) */
+  uint8_t* cls = w->cls;
+  for (size_t y = R->y0; y <= R->y1; ++y)
+    for (size_t x = R->x0; x <= R->x1; ++x) {
+      size_t p = y * N + x;
+      int32_t t = R->owner[p];
+      cls[p] = t >= 0 ? 1 : 0;
+      if (t >= 0) {
+        w->owned[t]++;
+        if (persp)
+          R->depth[p] = (float)(-1.0 / (double)R->depth[p]);
+      }
+    }
+
+  /* 3. eta over the retained triangles; optional removal of partly visible ones */
+  double eta = 0.0;
+  for (size_t t = 0; t < w->nt; ++t) {
+    int retained = w->owned[t] > 0;
+    if (prm->drop_partial)
+      retained = retained && w->owned[t] == w->covered[t];
+    if (!retained && !prm->eta_all)
+      continue;
+    double z0 = w->vdepth[corner(w, t, 0)], z1 = w->vdepth[corner(w, t, 1)],
+           z2 = w->vdepth[corner(w, t, 2)];
+    double span = fmax(z0, fmax(z1, z2)) - fmin(z0, fmin(z1, z2));
+    eta = span > eta ? span : eta;
+  }
+  if (prm->drop_partial) {
+    for (size_t y = R->y0; y <= R->y1; ++y)
+      for (size_t x = R->x0; x <= R->x1; ++x) {
+        size_t p = y * N + x;
+        int32_t t = R->owner[p];
+        if (t >= 0 && w->owned[t] != w->covered[t]) {
+          R->owner[p] = -1;
+          R->depth[p] = INFINITY;
+          cls[p] = 0;
+        }
+      }
+  }
+  /* float depths: allow a few ulps of the scene size on top of eta */
+  const double thr = eta + 1e-5 * radius;
+
+  /* seam closing: each round, empty pixels next to drawn ones copy the nearest
+   * of them. cls marks drawn pixels (1) and the round + 1 a pixel was filled
+   * in; pixels outside the rectangle are empty and their cls is stale. */
+  size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
+  if (gap > 0) {
+    size_t g = gap;
+    x0 = x0 >= g ? x0 - g : 0;
+    y0 = y0 >= g ? y0 - g : 0;
+    x1 = x1 + g < N ? x1 + g : N - 1;
+    y1 = y1 + g < N ? y1 + g : N - 1;
+    for (size_t y = y0; y <= y1; ++y) /* the new border strips are empty */
+      for (size_t x = x0; x <= x1; ++x)
+        if (y < R->y0 || y > R->y1 || x < R->x0 || x > R->x1)
+          cls[y * N + x] = 0;
+    R->x0 = x0; /* so dacpo_raster_clear resets the filled pixels too */
+    R->y0 = y0;
+    R->x1 = x1;
+    R->y1 = y1;
+    for (size_t round = 1; round <= g; ++round) {
+      const uint8_t stamp = (uint8_t)(round + 1);
+      for (size_t y = y0; y <= y1; ++y)
+        for (size_t x = x0; x <= x1; ++x) {
+          size_t p = y * N + x;
+          if (cls[p] != 0)
+            continue;
+          size_t nb[4];
+          int nn = 0;
+          if (x > x0 && cls[p - 1] != 0 && cls[p - 1] != stamp)
+            nb[nn++] = p - 1;
+          if (x < x1 && cls[p + 1] != 0 && cls[p + 1] != stamp)
+            nb[nn++] = p + 1;
+          if (y > y0 && cls[p - N] != 0 && cls[p - N] != stamp)
+            nb[nn++] = p - N;
+          if (y < y1 && cls[p + N] != 0 && cls[p + N] != stamp)
+            nb[nn++] = p + N;
+          if (nn == 0)
+            continue;
+          size_t best = nb[0];
+          for (int k = 1; k < nn; ++k)
+            if (R->depth[nb[k]] < R->depth[best])
+              best = nb[k];
+          R->owner[p] = R->owner[best];
+          R->depth[p] = R->depth[best];
+          cls[p] = stamp;
+        }
+    }
+  }
+
+  /* 4. atoms: same mesh, depth-continuous, same facing; mark cross pairs.
+   * cls = 0 empty, else 1 + 2 * mesh + back (one byte read per neighbour). */
+  const int32_t nat = (int32_t)w->na_t;
+  int32_t* parent = w->parent;
+  const float* depth = R->depth;
+  for (size_t y = y0; y <= y1; ++y)
+    for (size_t x = x0; x <= x1; ++x) {
+      size_t p = y * N + x;
+      int32_t tp = R->owner[p];
+      if (tp < 0) {
+        cls[p] = 0;
+        continue;
+      }
+      uint8_t cp = (uint8_t)(1 + 2 * (tp >= nat) + w->back[tp]);
+      cls[p] = cp;
+      res->pix[tp >= nat]++;
+      parent[p] = (int32_t)p;
+      double dp = (double)depth[p];
+      /* left neighbour: p is still a singleton, so joining it is one store */
+      if (x > x0 && cls[p - 1] != 0 && fabs(dp - (double)depth[p - 1]) <= thr) {
+        uint8_t cq = cls[p - 1];
+        if (cq == cp)
+          parent[p] = parent[p - 1];
+        else if (((cq - 1) >> 1) != ((cp - 1) >> 1)) {
+          int same_face = ((cq - 1) & 1) == ((cp - 1) & 1);
+          uint8_t side = same_face ? PF_SAME : PF_DIFF;
+          w->flags[p] |= (uint8_t)(side | PF_LEFT_X | (same_face ? PF_LEFT_SAME : 0));
+          w->flags[p - 1] |= side;
+          res->cross_same += (size_t)same_face;
+          res->cross_diff += (size_t)!same_face;
+        }
+      }
+      if (y > y0 && cls[p - N] != 0 && fabs(dp - (double)depth[p - N]) <= thr) {
+        uint8_t cq = cls[p - N];
+        if (cq == cp) {
+          if (parent[p] != parent[p - N]) /* cheap test first: usually one root */
+            uf_union(parent, (int32_t)p, (int32_t)(p - N));
+        }
+        else if (((cq - 1) >> 1) != ((cp - 1) >> 1)) {
+          int same_face = ((cq - 1) & 1) == ((cp - 1) & 1);
+          uint8_t side = same_face ? PF_SAME : PF_DIFF;
+          w->flags[p] |= (uint8_t)(side | PF_UP_X | (same_face ? PF_UP_SAME : 0));
+          w->flags[p - N] |= side;
+          res->cross_same += (size_t)same_face;
+          res->cross_diff += (size_t)!same_face;
+        }
+      }
+    }
+
+  /* compact atom ids (roots precede their members in scan order) and the
+   * cross-pair unions of both labellings */
+  int32_t K = 0;
+  for (size_t y = y0; y <= y1; ++y)
+    for (size_t x = x0; x <= x1; ++x) {
+      size_t p = y * N + x;
+      uint8_t cp = cls[p];
+      if (cp == 0)
+        continue;
+      int32_t root = uf_find(parent, (int32_t)p);
+      int32_t id;
+      if (root == (int32_t)p) {
+        id = K++;
+        w->a_blk[id] = (uint8_t)((cp - 1) >> 1);
+        w->a_cnt[id] = 0;
+        w->a_cbs[id] = 0;
+        w->a_cbd[id] = 0;
+        w->a_par[0][id] = id;
+        w->a_par[1][id] = id;
+      }
+      else
+        id = w->atom[root];
+      w->atom[p] = id;
+      uint8_t f = w->flags[p];
+      w->a_cnt[id]++;
+      w->a_cbs[id] += (f & PF_SAME) ? 1 : 0;
+      w->a_cbd[id] += (f & PF_DIFF) ? 1 : 0;
+      if (f & PF_LEFT_X)
+        uf_union(w->a_par[(f & PF_LEFT_SAME) ? 0 : 1], id, w->atom[p - 1]);
+      if (f & PF_UP_X)
+        uf_union(w->a_par[(f & PF_UP_SAME) ? 0 : 1], id, w->atom[p - N]);
+      if (image != NULL) {
+        uint8_t code = cp;
+        if (f & (PF_SAME | PF_DIFF))
+          code |= DACPO_VCR_PIXEL_BOUNDARY;
+        image[p] = code;
+      }
+      w->flags[p] = 0;
+    }
+
+  /* 5. per labelling: sub-region sums, I = C_B * C1 * C2 (Eq. 6) */
+  const double n1 = (double)N, n2 = (double)N * (double)N;
+  for (int lab = 0; lab < 2; ++lab) {
+    int32_t* par = w->a_par[lab];
+    memset(w->acc_c1, 0, (size_t)K * sizeof(int32_t));
+    memset(w->acc_c2, 0, (size_t)K * sizeof(int32_t));
+    memset(w->acc_cb, 0, (size_t)K * sizeof(int32_t));
+    for (int32_t k = 0; k < K; ++k) {
+      int32_t r = uf_find(par, k);
+      if (w->a_blk[k])
+        w->acc_c2[r] += w->a_cnt[k];
+      else
+        w->acc_c1[r] += w->a_cnt[k];
+      w->acc_cb[r] += lab == 0 ? w->a_cbs[k] : w->a_cbd[k];
+    }
+    double sum = 0.0;
+    size_t regions = 0;
+    for (int32_t k = 0; k < K; ++k) {
+      if (par[k] != k || w->acc_c1[k] == 0 || w->acc_c2[k] == 0)
+        continue;
+      ++regions;
+      double I = ((double)w->acc_c1[k] / n2) * ((double)w->acc_c2[k] / n2);
+      if (prm->boundary_factor)
+        I *= (double)w->acc_cb[k] / n1;
+      sum += I;
+    }
+    if (lab == 0) {
+      res->alpha = sum;
+      res->regions[0] = regions;
+    }
+    else {
+      res->alpha_bar = sum;
+      res->regions[1] = regions;
+    }
+  }
+  res->eta = eta;
+}
+
+dacpo_status
+dacpo_vcr_edge_debug(const dacpo_mesh* a,
+                     const dacpo_mesh* b,
+                     const dacpo_vcr_params* params,
+                     double* alpha,
+                     double* alpha_bar,
+                     dacpo_vcr_view_stats* views,
+                     uint8_t* images,
+                     dacpo_err* err)
+{
+  dacpo_vcr_params prm;
+  if (params != NULL)
+    prm = *params;
+  else
+    dacpo_vcr_params_default(&prm);
+  if (alpha != NULL)
+    *alpha = 0.0;
+  if (alpha_bar != NULL)
+    *alpha_bar = 0.0;
+  DACPO_CHECK(err,
+              prm.image_size >= 8 && prm.image_size <= VCR_MAX_IMAGE,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: image_size %zu outside [8, %d]",
+              prm.image_size,
+              VCR_MAX_IMAGE);
+  DACPO_CHECK(err,
+              prm.num_views >= 1 && prm.num_views <= VCR_MAX_VIEWS,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: num_views %zu outside [1, %d]",
+              prm.num_views,
+              VCR_MAX_VIEWS);
+  DACPO_CHECK(err,
+              prm.perspective == 0 || prm.perspective == 1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: perspective must be 0 or 1 (got %d)",
+              prm.perspective);
+  DACPO_CHECK(err,
+              prm.boundary_factor == 0 || prm.boundary_factor == 1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: boundary_factor must be 0 or 1 (got %d)",
+              prm.boundary_factor);
+  DACPO_CHECK(
+      err,
+      prm.gap_fill <= 32 && 4 * (prm.gap_fill + 1) < prm.image_size,
+      DACPO_ERR_INVALID_ARGUMENT,
+      "vcr: gap_fill %zu too large for image_size %zu (max min(32, size/4 - 1))",
+      prm.gap_fill,
+      prm.image_size);
+  DACPO_CHECK(err,
+              prm.gap_fill_edges >= 0.0 && prm.gap_fill_edges <= 100.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: gap_fill_edges %g outside [0, 100]",
+              prm.gap_fill_edges);
+  DACPO_TRY(check_mesh(a, "a", err));
+  DACPO_TRY(check_mesh(b, "b", err));
+  if (views != NULL)
+    memset(views, 0, prm.num_views * sizeof(*views));
+  if (images != NULL)
+    memset(images, 0, prm.num_views * prm.image_size * prm.image_size);
+  if (a->num_triangles == 0 || b->num_triangles == 0)
+    return DACPO_OK; /* no region can span both blocks */
+
+  vcr_work w;
+  memset(&w, 0, sizeof(w));
+  w.N = prm.image_size;
+  w.m[0] = a;
+  w.m[1] = b;
+  w.na_t = a->num_triangles;
+  w.nt = a->num_triangles + b->num_triangles;
+  w.na_v = a->num_vertices;
+  w.nv = a->num_vertices + b->num_vertices;
+  double* dirs = (double*)dacpo_malloc_array(3 * prm.num_views, sizeof(double));
+  dacpo_status st = dirs == NULL ? DACPO_OOM(err) : work_alloc(&w, err);
+  if (st != DACPO_OK) {
+    free(dirs);
+    work_free(&w);
+    return st;
+  }
+  dacpo_vcr_view_directions(prm.num_views, dirs);
+
+  /* used vertices, union bounding box, face normals and centres */
+  double lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t t = 0; t < w.nt; ++t) {
+    const double* p[3];
+    for (int k = 0; k < 3; ++k) {
+      size_t gv = corner(&w, t, k);
+      w.used[gv] = 1;
+      p[k] = vertex_of(&w, gv);
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = p[k][c] < lo[c] ? p[k][c] : lo[c];
+        hi[c] = p[k][c] > hi[c] ? p[k][c] : hi[c];
+      }
+    }
+    double e1[3], e2[3];
+    for (int c = 0; c < 3; ++c) {
+      e1[c] = p[1][c] - p[0][c];
+      e2[c] = p[2][c] - p[0][c];
+      w.tri_centre[3 * t + (size_t)c] = (p[0][c] + p[1][c] + p[2][c]) / 3.0;
+    }
+    w.tri_normal[3 * t + 0] = e1[1] * e2[2] - e1[2] * e2[1];
+    w.tri_normal[3 * t + 1] = e1[2] * e2[0] - e1[0] * e2[2];
+    w.tri_normal[3 * t + 2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  w.edge_len = median_edge_length(&w);
+  double centre[3], radius = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    centre[c] = 0.5 * (lo[c] + hi[c]);
+    radius += 0.25 * (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  }
+  radius = sqrt(radius);
+
+  double sum_a = 0.0, sum_b = 0.0;
+  if (radius > 0.0 && isfinite(radius)) {
+    size_t npix = w.N * w.N;
+    for (size_t j = 0; j < prm.num_views; ++j) {
+      view_result res;
+      dacpo_raster_clear(&w.r);
+      run_view(&w,
+               &prm,
+               centre,
+               radius,
+               &dirs[3 * j],
+               &res,
+               images ? images + j * npix : NULL);
+      sum_a += res.alpha;
+      sum_b += res.alpha_bar;
+      if (views != NULL) {
+        dacpo_vcr_view_stats* vs = &views[j];
+        for (int c = 0; c < 3; ++c)
+          vs->direction[c] = dirs[3 * j + (size_t)c];
+        vs->eta = res.eta;
+        vs->pixels_a = res.pix[0];
+        vs->pixels_b = res.pix[1];
+        vs->cross_same = res.cross_same;
+        vs->cross_diff = res.cross_diff;
+        vs->regions = res.regions[0];
+        vs->regions_bar = res.regions[1];
+        vs->alpha = res.alpha;
+        vs->alpha_bar = res.alpha_bar;
+        vs->gap_pixels = res.gap;
+      }
+    }
+  }
+  free(dirs);
+  work_free(&w);
+  if (alpha != NULL)
+    *alpha = sum_a;
+  if (alpha_bar != NULL)
+    *alpha_bar = sum_b;
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_vcr_edge(const dacpo_mesh* a,
+               const dacpo_mesh* b,
+               const dacpo_vcr_params* params,
+               double* alpha,
+               double* alpha_bar,
+               dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              alpha != NULL && alpha_bar != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: alpha and alpha_bar must not be NULL");
+  return dacpo_vcr_edge_debug(a, b, params, alpha, alpha_bar, NULL, NULL, err);
+}

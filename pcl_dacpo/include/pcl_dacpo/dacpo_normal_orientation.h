@@ -1,0 +1,483 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/**
+ * \file dacpo_normal_orientation.h
+ * \brief pcl::DACPONormalOrientation: globally consistent normal orientation of
+ * open, scene-level point clouds with the DACPO method (TOG 2025), as a PCL
+ * feature.
+ *
+ * The class is a thin wrapper around the C core (<dacpo/dacpo.h>): it packs the
+ * finite points of the input, feeds the core PCL's neighbour search
+ * (pcl::search::KdTree, i.e. FLANN, unless another search is set) and copies the
+ * oriented normals back in the caller's point order.
+ */
+#pragma once
+
+#include <dacpo/dacpo.h>
+
+#include <pcl/features/feature.h>
+#include <pcl/memory.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pcl {
+
+/**
+ * \brief Orients point normals consistently over a whole scene with DACPO
+ * ("A Divide-and-Conquer Approach for Global Orientation of Non-Watertight
+ * Scene-Level Point Clouds Using 0-1 Integer Optimization", TOG 2025).
+ *
+ * The cloud is cut into spatially connected blocks, each block is oriented on its
+ * own (dipole-field initialisation, then iterative Poisson refinement), and a 0-1
+ * program over the block graph decides which blocks to flip.
+ *
+ * Normal axes, two ways:
+ * - setInputNormals() given (any cloud with normal_x/y/z indexed like the input,
+ *   e.g. pcl::PointCloud<pcl::Normal> from pcl::NormalEstimation, or the input
+ *   cloud itself when it is a pcl::PointNormal cloud): those axes are oriented,
+ *   their signs are ignored, and the output curvature is copied from them (0 if
+ *   their type has no curvature).
+ * - otherwise the core estimates PCA normals from the getNormalK() nearest
+ *   neighbours and the output curvature is the PCA surface variation.
+ *
+ * The neighbour graph the method works on has k = getKSearch() (default 10)
+ * neighbours per point; radius search is not supported. The search runs on the
+ * input cloud; a different search surface is rejected.
+ *
+ * Output: one point per entry of the indices (input order). Fields that
+ * PointInT and PointOutT share (x, y, z, rgb, ...) are copied from the input;
+ * normal_x/y/z are set to the oriented unit normal, and curvature when PointOutT
+ * has it. Points with a non-finite coordinate, or a non-finite or zero input
+ * normal, are skipped: they get NaN normals and curvature, and the output is
+ * then not dense.
+ *
+ * Several connected components of the k-NN graph are oriented separately (their
+ * relative sign is undefined) unless setDisconnectedPolicy() says otherwise; a
+ * PCL_WARN reports the count, getComponentLabels() tells them apart.
+ *
+ * Runs with the same parameters and seed give identical output, also with a
+ * different number of threads.
+ *
+ * \code
+ * pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
+ * dacpo.setInputCloud(cloud);
+ * dacpo.setInputNormals(normals); // optional
+ * pcl::PointCloud<pcl::Normal> oriented;
+ * dacpo.compute(oriented);
+ * \endcode
+ *
+ * \tparam PointInT  point type with x, y, z
+ * \tparam PointOutT point type with normal_x, normal_y, normal_z (and curvature)
+ */
+template <typename PointInT, typename PointOutT>
+class DACPONormalOrientation : public Feature<PointInT, PointOutT> {
+public:
+  using Ptr = shared_ptr<DACPONormalOrientation<PointInT, PointOutT>>;
+  using ConstPtr = shared_ptr<const DACPONormalOrientation<PointInT, PointOutT>>;
+  using PointCloudIn = typename Feature<PointInT, PointOutT>::PointCloudIn;
+  using PointCloudOut = typename Feature<PointInT, PointOutT>::PointCloudOut;
+
+  /**
+   * \brief Progress callback: the stage running and the fraction done in [0, 1].
+   * Called on the thread that runs compute(). Return false to cancel the run
+   * (compute() then fails with ::DACPO_ERR_CANCELLED and an empty output).
+   */
+  using ProgressCallback = std::function<bool(dacpo_stage stage, double fraction)>;
+
+  /** \brief Default parameters (dacpo_params_init()) and k = 10. */
+  DACPONormalOrientation();
+
+  /**
+   * \brief Give the normal axes to orient (signs are ignored).
+   * \param[in] normals a cloud with normal_x/y/z, one point per input point
+   *            (indexed like the input cloud, not like the indices). The cloud
+   *            is held, not copied, until resetInputNormals() or the next call.
+   */
+  template <typename PointNT>
+  void
+  setInputNormals(const shared_ptr<const PointCloud<PointNT>>& normals)
+  {
+    static_assert(pcl::traits::has_normal_v<PointNT>,
+                  "setInputNormals needs a point type with normal_x/y/z");
+    if (!normals) {
+      resetInputNormals();
+      return;
+    }
+    normals_holder_ = normals;
+    normals_size_ = normals->size();
+    normals_reader_ = &DACPONormalOrientation::readNormal<PointNT>;
+  }
+
+  /** \brief Overload for a non-const cloud pointer. */
+  template <typename PointNT>
+  void
+  setInputNormals(const shared_ptr<PointCloud<PointNT>>& normals)
+  {
+    setInputNormals<PointNT>(shared_ptr<const PointCloud<PointNT>>(normals));
+  }
+
+  /** \brief Forget the input normals: the next compute() estimates PCA normals. */
+  void
+  resetInputNormals()
+  {
+    normals_holder_.reset();
+    normals_size_ = 0;
+    normals_reader_ = nullptr;
+  }
+
+  /** \brief True if setInputNormals() gave normals for the next compute(). */
+  bool
+  hasInputNormals() const
+  {
+    return static_cast<bool>(normals_holder_);
+  }
+
+  /** \brief Neighbours for PCA normals when none are given (default 16, >= 3). */
+  void
+  setNormalK(std::size_t normal_k)
+  {
+    params_.normal_k = normal_k;
+  }
+  /** \brief See setNormalK(). */
+  std::size_t
+  getNormalK() const
+  {
+    return params_.normal_k;
+  }
+
+  /** \brief Target number of blocks; 0 = automatic, n/2500 in [1, 200] (default 0). */
+  void
+  setNumberOfBlocks(std::size_t num_blocks)
+  {
+    params_.num_blocks = num_blocks;
+  }
+  /** \brief See setNumberOfBlocks(). */
+  std::size_t
+  getNumberOfBlocks() const
+  {
+    return params_.num_blocks;
+  }
+
+  /** \brief Width of the overlap ring around each block, in k-NN hops (default 3). */
+  void
+  setRingHops(std::size_t ring_hops)
+  {
+    params_.ring_hops = ring_hops;
+  }
+  /** \brief See setRingHops(). */
+  std::size_t
+  getRingHops() const
+  {
+    return params_.ring_hops;
+  }
+
+  /** \brief Exponent c of the dipole field (paper Eq. 1): 4 clean, 2 noisy (default 4).
+   */
+  void
+  setDipoleC(double c)
+  {
+    params_.dipole_c = c;
+  }
+  /** \brief See setDipoleC(). */
+  double
+  getDipoleC() const
+  {
+    return params_.dipole_c;
+  }
+
+  /** \brief Number M of randomized propagation orders per block (default 5). */
+  void
+  setDipoleOrders(std::size_t orders)
+  {
+    params_.dipole_orders = orders;
+  }
+  /** \brief See setDipoleOrders(). */
+  std::size_t
+  getDipoleOrders() const
+  {
+    return params_.dipole_orders;
+  }
+
+  /** \brief Nearest already placed points summed per dipole decision (default 32). */
+  void
+  setDipoleNeighbors(std::size_t neighbors)
+  {
+    params_.dipole_neighbors = neighbors;
+  }
+  /** \brief See setDipoleNeighbors(). */
+  std::size_t
+  getDipoleNeighbors() const
+  {
+    return params_.dipole_neighbors;
+  }
+
+  /** \brief One re-decision sweep after the vote of the orders (default true). */
+  void
+  setDipoleFinalSweep(bool enabled)
+  {
+    params_.dipole_final_sweep = enabled ? 1 : 0;
+  }
+  /** \brief See setDipoleFinalSweep(). */
+  bool
+  getDipoleFinalSweep() const
+  {
+    return params_.dipole_final_sweep != 0;
+  }
+
+  /** \brief Run stage 3, iterative Poisson refinement per block (default true). */
+  void
+  setIPSREnabled(bool enabled)
+  {
+    params_.ipsr_enabled = enabled ? 1 : 0;
+  }
+  /** \brief See setIPSREnabled(). */
+  bool
+  getIPSREnabled() const
+  {
+    return params_.ipsr_enabled != 0;
+  }
+
+  /** \brief Iteration cap of the Poisson refinement per block (default 20). */
+  void
+  setIPSRMaxIterations(std::size_t iterations)
+  {
+    params_.ipsr_max_iterations = iterations;
+  }
+  /** \brief See setIPSRMaxIterations(). */
+  std::size_t
+  getIPSRMaxIterations() const
+  {
+    return params_.ipsr_max_iterations;
+  }
+
+  /** \brief Consistency measure of the block-graph edges (default dipole boundary). */
+  void
+  setEdgeWeight(dacpo_edge_weight weight)
+  {
+    params_.edge_weight = weight;
+  }
+  /** \brief See setEdgeWeight(). */
+  dacpo_edge_weight
+  getEdgeWeight() const
+  {
+    return params_.edge_weight;
+  }
+
+  /**
+   * \brief Seconds allowed to the 0-1 program (default 30). When it runs out the
+   * best feasible answer is used and a PCL_WARN says it is not proven optimal.
+   */
+  void
+  setSolverTimeLimit(double seconds)
+  {
+    params_.solver_time_limit = seconds;
+  }
+  /** \brief See setSolverTimeLimit(). */
+  double
+  getSolverTimeLimit() const
+  {
+    return params_.solver_time_limit;
+  }
+
+  /** \brief Seed all randomness derives from (default 1). */
+  void
+  setSeed(std::uint64_t seed)
+  {
+    params_.seed = seed;
+  }
+  /** \brief See setSeed(). */
+  std::uint64_t
+  getSeed() const
+  {
+    return params_.seed;
+  }
+
+  /**
+   * \brief Worker threads; 0 = all cores (default), as in NormalEstimationOMP.
+   * The search method is then queried from several threads at once.
+   */
+  void
+  setNumberOfThreads(unsigned int num_threads = 0)
+  {
+    params_.num_threads = num_threads;
+  }
+  /** \brief See setNumberOfThreads(). */
+  unsigned int
+  getNumberOfThreads() const
+  {
+    return params_.num_threads;
+  }
+
+  /** \brief What to do with a disconnected k-NN graph (default: orient separately). */
+  void
+  setDisconnectedPolicy(dacpo_disconnected_policy policy)
+  {
+    params_.disconnected = policy;
+  }
+  /** \brief See setDisconnectedPolicy(). */
+  dacpo_disconnected_policy
+  getDisconnectedPolicy() const
+  {
+    return params_.disconnected;
+  }
+
+  /** \brief Components smaller than this are oriented as one block (default 1). */
+  void
+  setMinComponentSize(std::size_t size)
+  {
+    params_.min_component_size = size;
+  }
+  /** \brief See setMinComponentSize(). */
+  std::size_t
+  getMinComponentSize() const
+  {
+    return params_.min_component_size;
+  }
+
+  /**
+   * \brief Set every core parameter at once. params.k replaces setKSearch();
+   * params.estimate_normals is ignored (decided by setInputNormals()).
+   */
+  void
+  setParameters(const dacpo_params& params)
+  {
+    params_ = params;
+    this->k_ = static_cast<int>(params.k);
+  }
+  /** \brief The parameters the next compute() passes to the core (k from getKSearch()).
+   */
+  dacpo_params
+  getParameters() const
+  {
+    dacpo_params p = params_;
+    p.k = this->k_ > 0 ? static_cast<std::size_t>(this->k_) : 0;
+    p.estimate_normals = hasInputNormals() ? 0 : 1;
+    return p;
+  }
+
+  /** \brief Called during compute(); an empty function (default) disables it. */
+  void
+  setProgressCallback(const ProgressCallback& callback)
+  {
+    progress_ = callback;
+  }
+
+  /** \brief Status of the last compute() (::DACPO_OK on success). */
+  dacpo_status
+  getLastStatus() const
+  {
+    return last_status_;
+  }
+  /** \brief Message of the last failure, "" after a success. */
+  const std::string&
+  getLastError() const
+  {
+    return last_error_;
+  }
+
+  /** \brief Core statistics of the last compute() (timings per stage, blocks, ...). */
+  dacpo_stats
+  getStats() const
+  {
+    return stats_;
+  }
+
+  /**
+   * \brief Connected component of each output point in the last compute(), in
+   * output order; -1 for skipped (non-finite) points. Empty after a failure.
+   */
+  const std::vector<int>&
+  getComponentLabels() const
+  {
+    return component_labels_;
+  }
+
+  /** \brief Block of each output point (as getComponentLabels()). */
+  const std::vector<int>&
+  getBlockLabels() const
+  {
+    return block_labels_;
+  }
+
+  /** \brief Per block: 1 if the 0-1 program flipped it (getStats().num_blocks entries).
+   */
+  const std::vector<std::uint8_t>&
+  getBlockFlips() const
+  {
+    return block_flips_;
+  }
+
+  /** \brief Block-graph edges of the last compute() with their weights. */
+  const std::vector<dacpo_edge_info>&
+  getEdges() const
+  {
+    return edges_;
+  }
+
+protected:
+  using Feature<PointInT, PointOutT>::feature_name_;
+  using Feature<PointInT, PointOutT>::getClassName;
+  using Feature<PointInT, PointOutT>::indices_;
+  using Feature<PointInT, PointOutT>::input_;
+  using Feature<PointInT, PointOutT>::surface_;
+  using Feature<PointInT, PointOutT>::fake_surface_;
+  using Feature<PointInT, PointOutT>::tree_;
+  using Feature<PointInT, PointOutT>::k_;
+  using Feature<PointInT, PointOutT>::search_radius_;
+
+  /** \brief Orient the normals of the points of indices_ into \a output. */
+  void
+  computeFeature(PointCloudOut& output) override;
+
+private:
+  /** \brief Reads normal i of the held normals cloud: axis and curvature. */
+  using NormalReader = void (*)(const void* cloud,
+                                std::size_t i,
+                                float normal[3],
+                                float* curvature);
+
+  template <typename PointNT>
+  static void
+  readNormal(const void* cloud, std::size_t i, float normal[3], float* curvature)
+  {
+    const PointNT& p = (*static_cast<const PointCloud<PointNT>*>(cloud))[i];
+    normal[0] = p.normal_x;
+    normal[1] = p.normal_y;
+    normal[2] = p.normal_z;
+    if constexpr (pcl::traits::has_curvature_v<PointNT>)
+      *curvature = p.curvature;
+    else
+      *curvature = 0.0f;
+  }
+
+  /** \brief Clears the output and logs a failure of the run. */
+  void
+  fail(PointCloudOut& output, dacpo_status status, const std::string& message);
+
+  dacpo_params params_;
+  ProgressCallback progress_;
+
+  /** Type-erased input normals: the cloud (kept alive), its size and a reader. */
+  shared_ptr<const void> normals_holder_;
+  std::size_t normals_size_ = 0;
+  NormalReader normals_reader_ = nullptr;
+
+  dacpo_status last_status_ = DACPO_OK;
+  std::string last_error_;
+  dacpo_stats stats_;
+  std::vector<int> component_labels_;
+  std::vector<int> block_labels_;
+  std::vector<std::uint8_t> block_flips_;
+  std::vector<dacpo_edge_info> edges_;
+};
+
+} // namespace pcl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <pcl_dacpo/impl/dacpo_normal_orientation.hpp>
+#endif

@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// PCA normals: known answers on a plane and a sphere, and finite unit vectors
+// for degenerate (collinear, coincident, isolated) neighbourhoods.
+extern "C" {
+#include "dacpo_normals.h"
+}
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace {
+
+// A distinct cloud from double coordinates (no float rounding), so a plane
+// stays exactly planar up to double precision.
+struct DoubleCloud {
+  std::vector<double> xyz, nrm;
+  std::vector<int32_t> rep, map;
+  dacpo_cloud c{};
+  explicit DoubleCloud(std::vector<double> p)
+      : xyz(std::move(p))
+  {
+    size_t n = xyz.size() / 3;
+    nrm.assign(3 * n, 0.0);
+    rep.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      rep[i] = static_cast<int32_t>(i);
+    map = rep;
+    c.n = n;
+    c.input_count = n;
+    c.xyz = xyz.data();
+    c.nrm = nrm.data();
+    c.rep_input = rep.data();
+    c.input_to_point = map.data();
+  }
+};
+
+struct Graph {
+  dacpo_knn_graph g{};
+  ~Graph() { dacpo_knn_graph_free(&g); }
+};
+
+double
+norm3(const double* v)
+{
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+// |sin| of the angle between two axes (sign-free)
+double
+axisError(const double* a, const double* b)
+{
+  double c[3] = {
+      a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  return norm3(c) / (norm3(a) * norm3(b));
+}
+
+void
+expectUnitFinite(const std::vector<double>& nrm, const std::vector<float>& curv)
+{
+  for (size_t i = 0; i < curv.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(nrm[3 * i]) && std::isfinite(nrm[3 * i + 1]) &&
+                std::isfinite(nrm[3 * i + 2]))
+        << "point " << i;
+    EXPECT_NEAR(norm3(&nrm[3 * i]), 1.0, 1e-12) << "point " << i;
+    EXPECT_TRUE(std::isfinite(curv[i]));
+    EXPECT_GE(curv[i], 0.0f);
+    EXPECT_LE(curv[i], 1.0f / 3.0f + 1e-6f);
+  }
+}
+
+} // namespace
+
+TEST(DacpoNormals, PlaneNormalsAreExact)
+{
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const size_t n = 3000;
+  std::vector<double> p(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    double x = u(rng), y = u(rng);
+    p[3 * i] = x;
+    p[3 * i + 1] = y;
+    p[3 * i + 2] = 0.3 * x - 0.2 * y;
+  }
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 16, nullptr, 2, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(3 * n, NAN);
+  std::vector<float> curv(n, -1.0f);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 16, 2, nrm.data(), curv.data(), &err),
+            DACPO_OK)
+      << err.msg;
+  const double truth[3] = {-0.3, 0.2, 1.0};
+  expectUnitFinite(nrm, curv);
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_LT(axisError(&nrm[3 * i], truth), 1e-6) << "point " << i;
+    EXPECT_LT(curv[i], 1e-10f);
+  }
+}
+
+TEST(DacpoNormals, SphereNormalsAreRadial)
+{
+  std::mt19937 rng(2);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const size_t n = 4000;
+  std::vector<double> p(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    double v[3] = {gauss(rng), gauss(rng), gauss(rng)};
+    double l = norm3(v);
+    for (int d = 0; d < 3; ++d)
+      p[3 * i + d] = 2.0 + 5.0 * v[d] / l; // radius 5, centre (2, 2, 2)
+  }
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 12, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(3 * n);
+  std::vector<float> curv(n);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 12, 1, nrm.data(), curv.data(), &err),
+            DACPO_OK);
+  expectUnitFinite(nrm, curv);
+  double worst = 0.0, mean_curv = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    double radial[3] = {p[3 * i] - 2.0, p[3 * i + 1] - 2.0, p[3 * i + 2] - 2.0};
+    worst = std::max(worst, axisError(&nrm[3 * i], radial));
+    mean_curv += curv[i] / static_cast<double>(n);
+  }
+  EXPECT_LT(worst, 0.1);      // sin of the angle: under ~6 degrees for every point
+  EXPECT_GT(mean_curv, 1e-5); // curved, unlike the plane
+  EXPECT_LT(mean_curv, 0.02);
+}
+
+TEST(DacpoNormals, RotatedRingWithRepeatedEigenvalues)
+{
+  // 16 points on a circle plus the centre, in a tilted plane: l1 == l2.
+  const double a[3] = {1.0 / std::sqrt(2.0), 0.0, 1.0 / std::sqrt(2.0)};
+  const double b[3] = {-0.5, 1.0 / std::sqrt(2.0), 0.5};
+  const double truth[3] = {
+      a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  std::vector<double> p = {10.0, -3.0, 7.0};
+  for (int j = 0; j < 16; ++j) {
+    double t = 2.0 * M_PI * j / 16.0;
+    for (int d = 0; d < 3; ++d)
+      p.push_back(p[d] + 0.01 * (std::cos(t) * a[d] + std::sin(t) * b[d]));
+  }
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 16, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(3 * 17);
+  std::vector<float> curv(17);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 16, 1, nrm.data(), curv.data(), &err),
+            DACPO_OK);
+  expectUnitFinite(nrm, curv);
+  for (size_t i = 0; i < 17; ++i)
+    EXPECT_LT(axisError(&nrm[3 * i], truth), 1e-9) << "point " << i;
+}
+
+TEST(DacpoNormals, CollinearNeighbourhoodGivesPerpendicularUnitAxis)
+{
+  std::vector<double> p;
+  const double dir[3] = {2.0 / 3.0, -1.0 / 3.0, 2.0 / 3.0};
+  for (int i = 0; i < 20; ++i)
+    for (int d = 0; d < 3; ++d)
+      p.push_back(1.0 + 0.1 * i * dir[d]);
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 6, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(3 * 20);
+  std::vector<float> curv(20);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 6, 1, nrm.data(), curv.data(), &err),
+            DACPO_OK);
+  expectUnitFinite(nrm, curv);
+  for (size_t i = 0; i < 20; ++i) {
+    double dot =
+        nrm[3 * i] * dir[0] + nrm[3 * i + 1] * dir[1] + nrm[3 * i + 2] * dir[2];
+    EXPECT_LT(std::fabs(dot), 1e-9) << "point " << i;
+    EXPECT_LT(curv[i], 1e-12f);
+  }
+}
+
+TEST(DacpoNormals, CoincidentAndIsolatedNeighbourhoodsAreFinite)
+{
+  // Five identical points (a cloud built by hand, so not merged) whose graph
+  // lists each other, and a sixth point with no neighbours at all.
+  std::vector<double> p;
+  for (int i = 0; i < 5; ++i)
+    p.insert(p.end(), {0.5, 0.5, 0.5});
+  p.insert(p.end(), {9.0, 9.0, 9.0});
+  DoubleCloud dc(p);
+  dacpo_knn_graph g{};
+  g.n = 6;
+  g.k = 4;
+  std::vector<int32_t> idx(24, -1);
+  std::vector<float> sqd(24, INFINITY);
+  for (int i = 0; i < 5; ++i)
+    for (int r = 0, j = 0; j < 5; ++j)
+      if (j != i) {
+        idx[i * 4 + r] = j;
+        sqd[i * 4 + r++] = 0.0f;
+      }
+  g.idx = idx.data();
+  g.sqd = sqd.data();
+  std::vector<double> nrm(18, NAN);
+  std::vector<float> curv(6, -1.0f);
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g, 4, 1, nrm.data(), curv.data(), &err),
+            DACPO_OK);
+  expectUnitFinite(nrm, curv);
+  for (float c : curv)
+    EXPECT_EQ(c, 0.0f);
+  // curvature may be skipped
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g, 0, 1, nrm.data(), nullptr, &err), DACPO_OK);
+  EXPECT_NEAR(norm3(&nrm[0]), 1.0, 1e-12);
+}
+
+TEST(DacpoNormals, FarFromOriginStaysAccurate)
+{
+  // A 1 mm grid on a tilted plane, a kilometre from the origin.
+  std::vector<double> p;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      double x = 1000.0 + 0.001 * i, y = -2000.0 + 0.001 * j;
+      p.insert(p.end(), {x, y, 500.0 + 0.5 * (x - 1000.0) + 0.25 * (y + 2000.0)});
+    }
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 10, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(p.size());
+  std::vector<float> curv(p.size() / 3);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 10, 1, nrm.data(), curv.data(), &err),
+            DACPO_OK);
+  const double truth[3] = {-0.5, -0.25, 1.0};
+  for (size_t i = 0; i < curv.size(); ++i)
+    ASSERT_LT(axisError(&nrm[3 * i], truth), 1e-6) << "point " << i;
+}
+
+TEST(DacpoNormals, ThreadsDoNotChangeResults)
+{
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> p(3 * 10000);
+  for (double& v : p)
+    v = u(rng);
+  DoubleCloud dc(p);
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 10, nullptr, 2, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> n1(p.size()), n2(p.size());
+  std::vector<float> c1(10000), c2(10000);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 10, 1, n1.data(), c1.data(), &err),
+            DACPO_OK);
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 10, 2, n2.data(), c2.data(), &err),
+            DACPO_OK);
+  EXPECT_EQ(n1, n2);
+  EXPECT_EQ(c1, c2);
+}
+
+TEST(DacpoNormals, RejectsBadArguments)
+{
+  DoubleCloud dc({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  Graph g;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_knn_build(&dc.c, 2, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  std::vector<double> nrm(9);
+  EXPECT_EQ(dacpo_normals_pca(&dc.c, &g.g, 3, 1, nrm.data(), nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_normals_pca(&dc.c, nullptr, 2, 1, nrm.data(), nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_normals_pca(&dc.c, &g.g, 2, 1, nullptr, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  // three points span a plane: the normal is z
+  ASSERT_EQ(dacpo_normals_pca(&dc.c, &g.g, 2, 1, nrm.data(), nullptr, &err), DACPO_OK);
+  EXPECT_NEAR(std::fabs(nrm[2]), 1.0, 1e-12);
+}

@@ -1,0 +1,347 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Shared by the pcl_dacpo_* tools: load/save pcl::PCLPointCloud2 by extension
+ * with clear errors, read named float fields of any numeric type, strict number
+ * parsing of options. Header-only, tools only (not installed). */
+#pragma once
+
+#include <pcl/common/io.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/PCLPointCloud2.h>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace dacpo_tool {
+
+/** Lower-case extension including the dot (".pcd"), or "". */
+inline std::string
+extension(const std::string& path)
+{
+  const std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || path.find('/', dot) != std::string::npos)
+    return "";
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
+  return ext;
+}
+
+/** Positional .pcd/.ply arguments in command-line order; values of the options
+ *  named in \a value_options (e.g. "-colored out.pcd") are not positional. */
+inline std::vector<std::string>
+fileArguments(int argc,
+              char** argv,
+              std::initializer_list<const char*> value_options = {})
+{
+  std::vector<std::string> files;
+  for (int i = 1; i < argc; ++i) {
+    const std::string ext = extension(argv[i]);
+    if (ext != ".pcd" && ext != ".ply")
+      continue;
+    if (i > 1 &&
+        std::any_of(value_options.begin(), value_options.end(), [&](const char* o) {
+          return std::strcmp(argv[i - 1], o) == 0;
+        }))
+      continue;
+    files.emplace_back(argv[i]);
+  }
+  return files;
+}
+
+/** Loads a .pcd or .ply into \a cloud and checks it is complete and has x, y, z.
+ *  On failure returns false with a message in \a error. */
+inline bool
+loadCloud2(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error)
+{
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) {
+    error = "cannot open '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    error = "'" + path + "' is not a regular file";
+    return false;
+  }
+  if (st.st_size == 0) {
+    error = "'" + path + "' is empty (0 bytes)";
+    return false;
+  }
+  const std::string ext = extension(path);
+  int rc = -1;
+  if (ext == ".pcd") {
+    pcl::PCDReader reader;
+    rc = reader.read(path, cloud);
+  }
+  else if (ext == ".ply") {
+    pcl::PLYReader reader;
+    rc = reader.read(path, cloud);
+  }
+  else {
+    error = "'" + path + "': unknown extension (use .pcd or .ply)";
+    return false;
+  }
+  if (rc < 0) {
+    error = "cannot read '" + path + "' (not a valid " + ext.substr(1) +
+            " file, or truncated)";
+    return false;
+  }
+  const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (cloud.data.size() != points * cloud.point_step) {
+    error = "'" + path + "' is truncated or inconsistent: header says " +
+            std::to_string(points) + " points, data holds " +
+            std::to_string(cloud.point_step ? cloud.data.size() / cloud.point_step : 0);
+    return false;
+  }
+  if (pcl::getFieldIndex(cloud, "x") < 0 || pcl::getFieldIndex(cloud, "y") < 0 ||
+      pcl::getFieldIndex(cloud, "z") < 0) {
+    error = "'" + path + "' has no x, y, z fields";
+    return false;
+  }
+  return true;
+}
+
+/** True if the cloud has all of the named fields. */
+inline bool
+hasFields(const pcl::PCLPointCloud2& cloud, std::initializer_list<const char*> names)
+{
+  for (const char* n : names)
+    if (pcl::getFieldIndex(cloud, n) < 0)
+      return false;
+  return true;
+}
+
+/** Value of a numeric field element as double. */
+inline double
+readValue(const std::uint8_t* p, std::uint8_t datatype)
+{
+  switch (datatype) {
+  case pcl::PCLPointField::INT8: {
+    std::int8_t v;
+    std::memcpy(&v, p, 1);
+    return v;
+  }
+  case pcl::PCLPointField::UINT8:
+    return *p;
+  case pcl::PCLPointField::INT16: {
+    std::int16_t v;
+    std::memcpy(&v, p, 2);
+    return v;
+  }
+  case pcl::PCLPointField::UINT16: {
+    std::uint16_t v;
+    std::memcpy(&v, p, 2);
+    return v;
+  }
+  case pcl::PCLPointField::INT32: {
+    std::int32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
+  }
+  case pcl::PCLPointField::UINT32: {
+    std::uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
+  }
+  case pcl::PCLPointField::FLOAT32: {
+    float v;
+    std::memcpy(&v, p, 4);
+    return v;
+  }
+  case pcl::PCLPointField::FLOAT64: {
+    double v;
+    std::memcpy(&v, p, 8);
+    return v;
+  }
+  default:
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+/** Reads three named fields of every point into packed floats (3 per point). */
+inline std::vector<float>
+readTriplet(const pcl::PCLPointCloud2& cloud,
+            const char* a,
+            const char* b,
+            const char* c)
+{
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  std::vector<float> out(3 * n);
+  const char* names[3] = {a, b, c};
+  for (int f = 0; f < 3; ++f) {
+    const pcl::PCLPointField& field = cloud.fields[pcl::getFieldIndex(cloud, names[f])];
+    for (std::size_t i = 0; i < n; ++i)
+      out[3 * i + f] = static_cast<float>(
+          readValue(&cloud.data[i * cloud.point_step + field.offset], field.datatype));
+  }
+  return out;
+}
+
+/** Copy of \a in without the named fields (data repacked). */
+inline pcl::PCLPointCloud2
+removeFields(const pcl::PCLPointCloud2& in, std::initializer_list<const char*> names)
+{
+  pcl::PCLPointCloud2 out;
+  out.header = in.header;
+  out.width = in.width;
+  out.height = in.height;
+  out.is_bigendian = in.is_bigendian;
+  out.is_dense = in.is_dense;
+  std::vector<const pcl::PCLPointField*> kept;
+  std::uint32_t offset = 0;
+  for (const auto& f : in.fields) {
+    if (std::any_of(
+            names.begin(), names.end(), [&](const char* n) { return f.name == n; }))
+      continue;
+    pcl::PCLPointField g = f;
+    g.offset = offset;
+    offset += static_cast<std::uint32_t>(pcl::getFieldSize(f.datatype)) *
+              std::max<std::uint32_t>(f.count, 1);
+    out.fields.push_back(g);
+    kept.push_back(&f);
+  }
+  out.point_step = offset;
+  out.row_step = out.point_step * out.width;
+  const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
+  out.data.resize(n * out.point_step);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t f = 0; f < kept.size(); ++f) {
+      const std::size_t bytes =
+          static_cast<std::size_t>(pcl::getFieldSize(kept[f]->datatype)) *
+          std::max<std::uint32_t>(kept[f]->count, 1);
+      std::memcpy(&out.data[i * out.point_step + out.fields[f].offset],
+                  &in.data[i * in.point_step + kept[f]->offset],
+                  bytes);
+    }
+  return out;
+}
+
+/** Copy of \a in with FLOAT32 fields appended after the existing ones;
+ *  \a values holds names.size() floats per point. */
+inline pcl::PCLPointCloud2
+appendFloatFields(const pcl::PCLPointCloud2& in,
+                  const std::vector<std::string>& names,
+                  const std::vector<float>& values)
+{
+  pcl::PCLPointCloud2 out;
+  out.header = in.header;
+  out.width = in.width;
+  out.height = in.height;
+  out.is_bigendian = in.is_bigendian;
+  out.is_dense = in.is_dense;
+  out.fields = in.fields;
+  const std::uint32_t extra = static_cast<std::uint32_t>(4 * names.size());
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    pcl::PCLPointField g;
+    g.name = names[f];
+    g.offset = in.point_step + static_cast<std::uint32_t>(4 * f);
+    g.datatype = pcl::PCLPointField::FLOAT32;
+    g.count = 1;
+    out.fields.push_back(g);
+  }
+  out.point_step = in.point_step + extra;
+  out.row_step = out.point_step * out.width;
+  const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
+  out.data.resize(n * out.point_step);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (in.point_step > 0)
+      std::memcpy(
+          &out.data[i * out.point_step], &in.data[i * in.point_step], in.point_step);
+    std::memcpy(&out.data[i * out.point_step + in.point_step],
+                &values[i * names.size()],
+                extra);
+  }
+  return out;
+}
+
+/** Writes binary-compressed PCD or binary PLY by extension. */
+inline bool
+saveCloud2(const std::string& path,
+           const pcl::PCLPointCloud2& cloud,
+           std::string& error)
+{
+  const std::string ext = extension(path);
+  int rc = -1;
+  if (ext == ".pcd") {
+    pcl::PCDWriter writer;
+    rc = writer.writeBinaryCompressed(path, cloud);
+  }
+  else if (ext == ".ply") {
+    pcl::PLYWriter writer;
+    rc = writer.writeBinary(
+        path, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), false);
+  }
+  else {
+    error = "'" + path + "': unknown extension (use .pcd or .ply)";
+    return false;
+  }
+  if (rc < 0) {
+    error = "cannot write '" + path + "'";
+    return false;
+  }
+  return true;
+}
+
+/** Strict parse of "-name value" as an unsigned integer; false + message on junk.
+ *  Leaves \a value unchanged when the option is absent. */
+inline bool
+parseUnsigned(
+    int argc, char** argv, const char* name, std::uint64_t& value, std::string& error)
+{
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], name) != 0)
+      continue;
+    if (i + 1 >= argc) {
+      error = std::string(name) + " needs a value";
+      return false;
+    }
+    const char* s = argv[i + 1];
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(s, &end, 10);
+    if (!*s || *end || errno || s[0] == '-') {
+      error = std::string(name) + " expects a non-negative integer, got '" + s + "'";
+      return false;
+    }
+    value = v;
+  }
+  return true;
+}
+
+/** Strict parse of "-name value" as a finite number. */
+inline bool
+parseDouble(int argc, char** argv, const char* name, double& value, std::string& error)
+{
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], name) != 0)
+      continue;
+    if (i + 1 >= argc) {
+      error = std::string(name) + " needs a value";
+      return false;
+    }
+    const char* s = argv[i + 1];
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s, &end);
+    if (!*s || *end || errno || !std::isfinite(v)) {
+      error = std::string(name) + " expects a number, got '" + s + "'";
+      return false;
+    }
+    value = v;
+  }
+  return true;
+}
+
+} // namespace dacpo_tool

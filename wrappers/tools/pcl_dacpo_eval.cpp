@@ -1,0 +1,351 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* pcl_dacpo_eval: the paper's orientation metric (§6). Share of points whose
+ * predicted normal makes more than 90 degrees with the ground truth, after one
+ * global flip when that lowers it (so at most 50 %), over all points and over
+ * the largest connected component of the k = 10 nearest-neighbour graph only
+ * (exact duplicates merged, graph symmetrized: the core's definition). A
+ * predicted normal that is not finite, or exactly perpendicular, is wrong under
+ * either sign (dacpo_score_oriented() in tests/support). */
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+
+#include "dacpo_scene.h"
+#include "dacpo_tool_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numeric>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+constexpr std::size_t kGraphK = 10;
+
+void
+printHelp(int, char** argv)
+{
+  print_error("Syntax is: %s ground_truth.{ply,pcd} predicted.{pcd,ply} <options>\n",
+              argv[0]);
+  print_info(
+      "  Percentage of points whose normal is more than 90 degrees from the ground\n");
+  print_info(
+      "  truth after one global flip (paper metric), over all points and over the\n");
+  print_info(
+      "  largest connected component of the k = 10 neighbour graph. Both files must\n");
+  print_info(
+      "  hold the same points in the same order; NaN predicted normals are wrong.\n");
+  print_info("  where options are:\n");
+  print_info("                     -colored out.pcd = write the points coloured blue "
+             "(correct)\n");
+  print_info("                                        or red (wrong) with the "
+             "predicted normals\n");
+  print_info(
+      "                     -json            = print one line of JSON on stdout:\n");
+  print_info("  {\"file\":..., \"points\":N, \"wrong_pct\":x, "
+             "\"largest_component_points\":M,\n");
+  print_info("   \"largest_component_wrong_pct\":y, \"components\":C}\n");
+}
+
+/* Disjoint sets with path halving and union by size. */
+struct DisjointSets {
+  std::vector<std::int32_t> parent, size;
+  explicit DisjointSets(std::size_t n)
+      : parent(n)
+      , size(n, 1)
+  {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
+  std::int32_t
+  find(std::int32_t a)
+  {
+    while (parent[a] != a) {
+      parent[a] = parent[parent[a]];
+      a = parent[a];
+    }
+    return a;
+  }
+  void
+  unite(std::int32_t a, std::int32_t b)
+  {
+    a = find(a);
+    b = find(b);
+    if (a == b)
+      return;
+    if (size[a] < size[b])
+      std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+  }
+};
+
+/* Component label of every point (numbered by first point), as the core defines
+ * them: exact duplicates merged, k nearest distinct neighbours, i ~ j if either
+ * lists the other. Returns the number of components. */
+std::size_t
+componentLabels(const std::vector<float>& xyz, std::vector<std::int32_t>& label)
+{
+  const std::size_t n = xyz.size() / 3;
+  /* Merge exact duplicates (-0 == +0 because the comparison is on values). */
+  std::vector<std::int32_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  auto less = [&](std::int32_t a, std::int32_t b) {
+    for (int d = 0; d < 3; ++d)
+      if (xyz[3 * a + d] != xyz[3 * b + d])
+        return xyz[3 * a + d] < xyz[3 * b + d];
+    return false;
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<std::int32_t> distinct_of(n);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::int32_t i = order[r];
+    if (r == 0 || less(order[r - 1], i))
+      cloud->push_back(pcl::PointXYZ(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+    distinct_of[i] = static_cast<std::int32_t>(cloud->size() - 1);
+  }
+  const std::size_t m = cloud->size();
+  DisjointSets sets(m);
+  if (m > 1) {
+    const int k = static_cast<int>(std::min(kGraphK, m - 1));
+    pcl::search::KdTree<pcl::PointXYZ> tree;
+    tree.setInputCloud(cloud);
+    pcl::Indices nn;
+    std::vector<float> nd;
+    for (std::size_t i = 0; i < m; ++i) {
+      /* k + 1: the query itself comes back (distinct points, so only once). */
+      tree.nearestKSearch((*cloud)[i], k + 1, nn, nd);
+      int taken = 0;
+      for (std::size_t j = 0; j < nn.size() && taken < k; ++j) {
+        if (nn[j] == static_cast<pcl::index_t>(i))
+          continue;
+        sets.unite(static_cast<std::int32_t>(i), nn[j]);
+        ++taken;
+      }
+    }
+  }
+  std::vector<std::int32_t> root_label(m, -1);
+  label.assign(n, -1);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t r = sets.find(distinct_of[i]);
+    if (root_label[r] < 0)
+      root_label[r] = static_cast<std::int32_t>(count++);
+    label[i] = root_label[r];
+  }
+  return count;
+}
+
+std::string
+jsonString(const std::string& s)
+{
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    }
+    else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+      out += buf;
+    }
+    else
+      out += static_cast<char>(c);
+  }
+  return out + "\"";
+}
+
+bool
+saveColored(const std::string& path,
+            const std::vector<float>& xyz,
+            const std::vector<float>& normals,
+            const std::vector<bool>& wrong)
+{
+  pcl::PointCloud<pcl::PointXYZRGBNormal> out;
+  out.resize(wrong.size());
+  for (std::size_t i = 0; i < wrong.size(); ++i) {
+    pcl::PointXYZRGBNormal& p = out[i];
+    p.x = xyz[3 * i];
+    p.y = xyz[3 * i + 1];
+    p.z = xyz[3 * i + 2];
+    p.normal_x = normals[3 * i];
+    p.normal_y = normals[3 * i + 1];
+    p.normal_z = normals[3 * i + 2];
+    p.curvature = 0.0f;
+    p.r = wrong[i] ? 255 : 0;
+    p.g = 0;
+    p.b = wrong[i] ? 0 : 255;
+  }
+  out.is_dense = false;
+  return pcl::io::savePCDFileBinaryCompressed(path, out) >= 0;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (argc < 3 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    printHelp(argc, argv);
+    return argc < 3 ? 1 : 0;
+  }
+  const std::vector<std::string> files =
+      dacpo_tool::fileArguments(argc, argv, {"-colored"});
+  if (files.size() != 2) {
+    print_error("Need a ground-truth and a predicted file (.pcd or .ply), got %zu.\n",
+                files.size());
+    printHelp(argc, argv);
+    return 1;
+  }
+  std::string colored;
+  parse_argument(argc, argv, "-colored", colored);
+  if (!colored.empty() && dacpo_tool::extension(colored) != ".pcd") {
+    print_error("Error: -colored needs a .pcd file name, got '%s'\n", colored.c_str());
+    return 1;
+  }
+  const bool json = find_switch(argc, argv, "-json");
+
+  pcl::PCLPointCloud2 gt2, pred2;
+  std::string error;
+  for (int f = 0; f < 2; ++f) {
+    pcl::PCLPointCloud2& c = f == 0 ? gt2 : pred2;
+    if (!dacpo_tool::loadCloud2(files[f], c, error)) {
+      print_error("Error: %s\n", error.c_str());
+      return 1;
+    }
+    if (!dacpo_tool::hasFields(c, {"normal_x", "normal_y", "normal_z"})) {
+      print_error("Error: '%s' has no normals (normal_x/y/z or nx/ny/nz)\n",
+                  files[f].c_str());
+      return 1;
+    }
+  }
+  const std::size_t n = static_cast<std::size_t>(gt2.width) * gt2.height;
+  const std::size_t n_pred = static_cast<std::size_t>(pred2.width) * pred2.height;
+  if (n != n_pred) {
+    print_error("Error: point counts differ: %zu in '%s', %zu in '%s'\n",
+                n,
+                files[0].c_str(),
+                n_pred,
+                files[1].c_str());
+    return 1;
+  }
+  if (n == 0) {
+    print_error("Error: '%s' has no points\n", files[0].c_str());
+    return 1;
+  }
+  const std::vector<float> xyz = dacpo_tool::readTriplet(gt2, "x", "y", "z");
+  const std::vector<float> gt =
+      dacpo_tool::readTriplet(gt2, "normal_x", "normal_y", "normal_z");
+  const std::vector<float> pred =
+      dacpo_tool::readTriplet(pred2, "normal_x", "normal_y", "normal_z");
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* p = &xyz[3 * i];
+    const float* g = &gt[3 * i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
+        !std::isfinite(g[0]) || !std::isfinite(g[1]) || !std::isfinite(g[2]) ||
+        (g[0] == 0.0f && g[1] == 0.0f && g[2] == 0.0f)) {
+      print_error("Error: ground-truth point %zu has a non-finite coordinate or a "
+                  "non-finite/zero normal\n",
+                  i);
+      return 1;
+    }
+  }
+  /* Same order? A reordered prediction would give a meaningless score. */
+  const std::vector<float> pxyz = dacpo_tool::readTriplet(pred2, "x", "y", "z");
+  double max_offset = 0.0, extent = 0.0;
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    if (std::isfinite(pxyz[i]))
+      max_offset =
+          std::max(max_offset, static_cast<double>(std::fabs(pxyz[i] - xyz[i])));
+    extent = std::max(extent, static_cast<double>(std::fabs(xyz[i])));
+  }
+  if (max_offset > 1e-4 * std::max(1.0, extent))
+    print_warn(stderr,
+               "Warning: predicted positions differ from the ground truth by up to "
+               "%g: are the points in the same order?\n",
+               max_offset);
+
+  std::size_t wrong_all = 0;
+  const double pct_all =
+      dacpo_score_oriented(gt.data(), pred.data(), n, nullptr, &wrong_all);
+
+  std::vector<std::int32_t> label;
+  const std::size_t components = componentLabels(xyz, label);
+  std::vector<std::size_t> sizes(components, 0);
+  for (std::int32_t l : label)
+    ++sizes[l];
+  const std::int32_t largest = static_cast<std::int32_t>(
+      std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  std::vector<float> gt_l, pred_l;
+  gt_l.reserve(3 * sizes[largest]);
+  pred_l.reserve(3 * sizes[largest]);
+  for (std::size_t i = 0; i < n; ++i)
+    if (label[i] == largest) {
+      gt_l.insert(gt_l.end(), &gt[3 * i], &gt[3 * i + 3]);
+      pred_l.insert(pred_l.end(), &pred[3 * i], &pred[3 * i + 3]);
+    }
+  const double pct_largest = dacpo_score_oriented(
+      gt_l.data(), pred_l.data(), sizes[largest], nullptr, nullptr);
+  if (pct_all < 0.0 || pct_largest < 0.0) {
+    print_error("Error: scoring failed (out of memory)\n");
+    return 1;
+  }
+
+  if (!colored.empty()) {
+    /* Per point under the global sign chosen for the all-points score. */
+    std::vector<bool> wrong(n);
+    std::size_t wrong_pos = 0, wrong_neg = 0;
+    std::vector<double> dot(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      dot[i] = static_cast<double>(gt[3 * i]) * pred[3 * i] +
+               static_cast<double>(gt[3 * i + 1]) * pred[3 * i + 1] +
+               static_cast<double>(gt[3 * i + 2]) * pred[3 * i + 2];
+      wrong_pos += !(dot[i] > 0.0);
+      wrong_neg += !(dot[i] < 0.0);
+    }
+    const bool flip = wrong_neg < wrong_pos;
+    for (std::size_t i = 0; i < n; ++i)
+      wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
+    if (!saveColored(colored, xyz, pred, wrong)) {
+      print_error("Error: cannot write '%s'\n", colored.c_str());
+      return 1;
+    }
+  }
+
+  if (json) {
+    std::printf(
+        "{\"file\":%s, \"points\":%zu, \"wrong_pct\":%.4f, "
+        "\"largest_component_points\":%zu, \"largest_component_wrong_pct\":%.4f, "
+        "\"components\":%zu}\n",
+        jsonString(files[1]).c_str(),
+        n,
+        pct_all,
+        sizes[largest],
+        pct_largest,
+        components);
+  }
+  else {
+    print_info("%s: ", files[1].c_str());
+    print_value("%.2f%%", pct_all);
+    print_info(" of ");
+    print_value("%zu", n);
+    print_info(" points wrong (");
+    print_value("%zu", wrong_all);
+    print_info("); largest of ");
+    print_value("%zu", components);
+    print_info(" component(s): ");
+    print_value("%.2f%%", pct_largest);
+    print_info(" of ");
+    print_value("%zu", sizes[largest]);
+    print_info(" points\n");
+  }
+  return 0;
+}
