@@ -53,7 +53,7 @@ for item in "${inputs[@]}"; do
     end=$(date +%s.%N)
     secs=$(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.2f", b-a}')
     rss=$(grep -o 'peak_rss_mb=[0-9.]*' "$out/res/$name.log" | tail -1 | cut -d= -f2 || true)
-    line=$("$tools/pcl_dacpo_eval" "$f" "$pred")
+    line=$("$tools/pcl_dacpo_eval" "$f" "$pred" -json)
     echo "${line%\}}, \"kind\": \"$kind\", \"seconds\": $secs, \"peak_rss_mb\": ${rss:-null}}" | tee -a "$results"
   else
     echo "{\"file\": \"$name\", \"kind\": \"$kind\", \"error\": \"orient failed, see $out/res/$name.log\"}" | tee -a "$results"

@@ -222,3 +222,40 @@ dacpo_edge_omega(double alpha, double alpha_bar, double* w_same, double* w_diff)
   if (w_diff)
     *w_diff = alpha_bar / den;
 }
+
+dacpo_status
+dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
+                                  const dacpo_blocks* blocks,
+                                  const double* own_nrm,
+                                  const double* ring_nrm,
+                                  dacpo_err* err)
+{
+  DACPO_CHECK(err, g && blocks && own_nrm, DACPO_ERR_INVALID_ARGUMENT,
+              "overlap weights: NULL graph, blocks or normals");
+  for (size_t e = 0; e < g->num_edges; ++e) {
+    g->edges[e].alpha = 0.0;
+    g->edges[e].alpha_bar = 0.0;
+  }
+  const size_t nb = blocks->num_blocks;
+  if (nb == 0 || blocks->ring_start[nb] == 0)
+    return DACPO_OK;
+  DACPO_CHECK(err, ring_nrm != NULL, DACPO_ERR_INVALID_ARGUMENT, "overlap weights: NULL ring normals");
+  for (size_t a = 0; a < nb; ++a)
+    for (size_t r = blocks->ring_start[a]; r < blocks->ring_start[a + 1]; ++r) {
+      const int32_t q = blocks->ring[r];
+      const int32_t b = blocks->block_of[q];
+      const ptrdiff_t e = dacpo_block_graph_find(g, (int32_t)a, b);
+      if (e < 0)
+        continue;
+      const double* na = ring_nrm + 3 * r;
+      const double* nq = own_nrm + 3 * (size_t)q;
+      const double d = na[0] * nq[0] + na[1] * nq[1] + na[2] * nq[2];
+      if (!isfinite(d))
+        continue;
+      if (d > 0.0)
+        g->edges[e].alpha += d;
+      else
+        g->edges[e].alpha_bar -= d;
+    }
+  return DACPO_OK;
+}

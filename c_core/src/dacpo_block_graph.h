@@ -45,6 +45,20 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
                                  double c,
                                  dacpo_err* err);
 
+/* Overlap-agreement weight: block a was oriented together with its ring, whose
+ * points belong to neighbouring blocks; where a's ring normal at a point q of
+ * block b meets b's own normal at q, d = n_a(q) . n_b(q) votes "same"
+ * (alpha += max(d, 0)) or "differ" (alpha_bar += max(-d, 0)). ring_nrm holds,
+ * for block a, the oriented normals of blocks->ring[ring_start[a] ..] (3 per
+ * ring entry); own_nrm the block-own normals of every point (3n). Ring points of
+ * blocks that are not adjacent to a in g are skipped. */
+dacpo_status
+dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
+                                  const dacpo_blocks* blocks,
+                                  const double* own_nrm,
+                                  const double* ring_nrm,
+                                  dacpo_err* err);
+
 /* Paper Eq. 7: w_same = alpha/(alpha+alpha_bar+eps), w_diff = alpha_bar/(...). */
 void
 dacpo_edge_omega(double alpha, double alpha_bar, double* w_same, double* w_diff);

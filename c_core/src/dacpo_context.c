@@ -64,12 +64,13 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_final_sweep = 1;
   p->ipsr_enabled = 1;
   p->ipsr_max_iterations = 20;
-  p->edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
+  p->edge_weight = DACPO_WEIGHT_VCR;
   p->solver_time_limit = 30.0;
   p->seed = 1;
   p->num_threads = 0;
   p->disconnected = DACPO_DISCONNECTED_SEPARATE;
   p->min_component_size = 1;
+  p->dipole_noise_band = 0.0;
 }
 
 static dacpo_status
@@ -113,11 +114,15 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (p->ipsr_max_iterations > 1000)
     return bad_field(message, size, "ipsr_max_iterations must be <= 1000 (got %zu)",
                      p->ipsr_max_iterations);
-  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY && p->edge_weight != DACPO_WEIGHT_VCR)
+  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY && p->edge_weight != DACPO_WEIGHT_VCR &&
+      p->edge_weight != DACPO_WEIGHT_OVERLAP)
     return bad_field(message, size, "edge_weight has an unknown value %d", (int)p->edge_weight);
   if (!(p->solver_time_limit > 0.0) || !isfinite(p->solver_time_limit))
     return bad_field(message, size, "solver_time_limit must be finite and > 0 (got %g)",
                      p->solver_time_limit);
+  if (!(p->dipole_noise_band >= 0.0) || !isfinite(p->dipole_noise_band))
+    return bad_field(message, size, "dipole_noise_band must be finite and >= 0 (got %g)",
+                     p->dipole_noise_band);
   if (p->num_threads > 1024)
     return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
   if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&

@@ -96,6 +96,53 @@ dipole_work_free(dipole_work* wk)
   dacpo_kdtree_free(wk->tree);
 }
 
+/* Median over points of the RMS distance of a point's K neighbours from its
+ * tangent plane: the block's scale of "flat within noise". */
+static double
+block_noise_scale(const double* xyz, const double* nrm, size_t n, size_t K, const int32_t* nb,
+                  double* tmp)
+{
+  for (size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    const double* m = nrm + 3 * i;
+    double s2 = 0.0;
+    for (size_t t = 0; t < K; ++t) {
+      const double* q = xyz + 3 * (size_t)nb[i * K + t];
+      const double d = (q[0] - p[0]) * m[0] + (q[1] - p[1]) * m[1] + (q[2] - p[2]) * m[2];
+      s2 += d * d;
+    }
+    tmp[i] = sqrt(s2 / (double)K);
+  }
+  /* median by nth-element on a copy-free buffer (tmp is scratch) */
+  size_t lo = 0, hi = n - 1, kth = n / 2;
+  while (lo < hi) {
+    const double pivot = tmp[lo + (hi - lo) / 2];
+    size_t a = lo, b = hi;
+    while (a <= b) {
+      while (tmp[a] < pivot)
+        ++a;
+      while (tmp[b] > pivot)
+        --b;
+      if (a <= b) {
+        const double t = tmp[a];
+        tmp[a] = tmp[b];
+        tmp[b] = t;
+        ++a;
+        if (b == 0)
+          break;
+        --b;
+      }
+    }
+    if (kth <= b)
+      hi = b;
+    else if (kth >= a)
+      lo = a;
+    else
+      break;
+  }
+  return tmp[kth];
+}
+
 /* K nearest of every point (self dropped) and the cached pair energies. */
 static dacpo_status
 dipole_neighbors(const double* xyz,
@@ -103,6 +150,7 @@ dipole_neighbors(const double* xyz,
                  size_t n,
                  size_t K,
                  double c,
+                 double noise_band,
                  dipole_work* wk,
                  dacpo_err* err)
 {
@@ -116,23 +164,49 @@ dipole_neighbors(const double* xyz,
   for (size_t i = 0; i < n; ++i) {
     const size_t found = dacpo_kdtree_knn(wk->tree, xyz + 3 * i, K + 1, wk->kbuf, wk->kd);
     int32_t* row = wk->nb + i * K;
-    double* wrow = wk->w + i * K;
     size_t t = 0;
     for (size_t f = 0; f < found && t < K; ++f) {
       const int32_t j = wk->kbuf[f];
       if (j < 0 || (size_t)j >= n || (size_t)j == i)
         continue;
-      row[t] = j;
-      /* Eq. 4: the field of the (earlier placed) neighbour j acting on i. */
-      wrow[t] = dacpo_dipole_energy(xyz + 3 * (size_t)j, nrm + 3 * (size_t)j, xyz + 3 * i,
-                                    nrm + 3 * i, c);
-      ++t;
+      row[t++] = j;
     }
-    /* Pad short rows (only with exact duplicates) with the point itself and a
-     * zero weight, so the decision loops need no branch. */
-    for (; t < K; ++t) {
+    /* Pad short rows (only with exact duplicates) with the point itself, which
+     * gets a zero weight below, so the decision loops need no branch. */
+    for (; t < K; ++t)
       row[t] = (int32_t)i;
-      wrow[t] = 0.0;
+  }
+  /* Noise band: measurement noise displaces points along the normal, which
+   * Eq. 1 reads as "stacked" (opposite orientation) for large c. Offsets within
+   * the block's noise scale are treated as coplanar; larger ones (a real second
+   * sheet, e.g. the other side of a thin board) keep the full field. */
+  double band = 0.0;
+  if (noise_band > 0.0 && n > 1) {
+    band = noise_band * block_noise_scale(xyz, nrm, n, K, wk->nb, wk->w);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t* row = wk->nb + i * K;
+    double* wrow = wk->w + i * K;
+    for (size_t t = 0; t < K; ++t) {
+      const size_t j = (size_t)row[t];
+      if (j == i) {
+        wrow[t] = 0.0;
+        continue;
+      }
+      const double* p = xyz + 3 * j;
+      const double* q = xyz + 3 * i;
+      const double* nj = nrm + 3 * j;
+      const double* ni = nrm + 3 * i;
+      double ce = c;
+      if (band > 0.0) {
+        const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        const double oj = fabs(r[0] * nj[0] + r[1] * nj[1] + r[2] * nj[2]);
+        const double oi = fabs(r[0] * ni[0] + r[1] * ni[1] + r[2] * ni[2]);
+        if (oj < band && oi < band)
+          ce = 0.0;
+      }
+      /* Eq. 4: the field of the (earlier placed) neighbour j acting on i. */
+      wrow[t] = dacpo_dipole_energy(p, nj, q, ni, ce);
     }
   }
   return DACPO_OK;
@@ -320,7 +394,7 @@ dacpo_dipole_orient(const double* xyz,
 
   dipole_work wk;
   memset(&wk, 0, sizeof(wk));
-  dacpo_status st = dipole_neighbors(xyz, nrm, n, K, params->c, &wk, err);
+  dacpo_status st = dipole_neighbors(xyz, nrm, n, K, params->c, params->noise_band, &wk, err);
   if (st == DACPO_OK)
     st = dipole_graph(n, K, gk, &wk, err);
   if (st == DACPO_OK) {

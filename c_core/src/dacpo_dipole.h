@@ -14,6 +14,10 @@ typedef struct dacpo_dipole_params {
   int final_sweep;    /* one re-decision sweep with all neighbours placed */
   uint64_t seed;
   uint64_t stream;    /* e.g. the block id: independent of thread count */
+  double noise_band;  /* 0 = off; else pairs whose offsets along both normals are
+                         below noise_band * (the block's median RMS offset of
+                         neighbours from a point's tangent plane) count as
+                         coplanar: the c term of Eq. 1 is dropped for them */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for

@@ -1,29 +1,31 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 3: iPSR with a Neumann screened Poisson solver, one block at a time
- * (paper §4.3, ALGORITHM.md §3). */
+ * (paper §4.3, ALGORITHM.md §3). Implemented in dacpo_ipsr.c on top of
+ * dacpo_poisson.h (solver) and dacpo_mcubes.h (iso-surface). */
 #ifndef DACPO_IPSR_H
 #define DACPO_IPSR_H
 
 #include "dacpo_internal.h"
 
 typedef struct dacpo_ipsr_params {
-  size_t max_iterations;  /* 20 */
-  double convergence;     /* 0.1: mean of the largest max(ceil(n/1000),10) |dn| */
-  size_t face_k;          /* 10 nearest samples per face */
-  size_t trim_start;      /* iteration from which wings are trimmed (5) */
-  double trim_spacings;   /* faces farther than this many spacings from the data (2.5) */
-  double point_weight;    /* screening alpha */
-  double cell_per_spacing; /* cell size / median spacing */
-  size_t max_resolution;  /* cap on cells per axis */
+  size_t max_iterations; /* 20 */
+  double convergence;    /* 0.1: mean of the largest max(ceil(n/1000),10) |dn| */
+  size_t face_k;         /* 10 nearest samples per face */
+  size_t trim_start;     /* iteration from which wings are trimmed (5, 0-based) */
+  double trim_spacings;  /* faces farther than this many spacings from the data (2.5) */
+  double point_weight;   /* screening alpha, PSR convention (16) */
+  double cell_per_spacing; /* cell size / median spacing (1.0) */
+  size_t max_resolution;   /* cap on cells per axis (128) */
   /* Added by the stage-3 implementation (defaults from dacpo_ipsr_params_default;
    * 0 selects the default for the first four): */
-  double padding;           /* box grows by this share of its longest side (0.1) */
-  size_t max_cells;         /* cap on grid cells, bounds memory (2^21) */
-  double tolerance;         /* Poisson solve: relative residual (1e-3) */
+  double padding;   /* band 0 only: box grows by this share of its longest side (0.1) */
+  size_t max_cells; /* cap on grid cells, bounds memory (1.5e6: <= 41 MB) */
+  double tolerance; /* Poisson solve: relative residual (3e-2; the warm-started
+                       loop refines chi across iterations) */
   size_t max_cg_iterations; /* Poisson solve: multigrid-CG steps (30) */
   int trim_interior;        /* 1: trim every far face, also inside the data (0) */
   size_t band;              /* Poisson domain: cells within this many cells of the
-                               samples; 0 = the whole padded box (6) */
+                               samples (>= 2); 0 = the whole padded box (2) */
 } dacpo_ipsr_params;
 
 void
@@ -31,27 +33,33 @@ dacpo_ipsr_params_default(dacpo_ipsr_params* p);
 
 typedef struct dacpo_ipsr_stats {
   size_t iterations;
-  size_t resolution;  /* cells per axis used */
+  size_t resolution; /* cells per axis used */
   double seconds;
   size_t peak_bytes;
   /* Added by the stage-3 implementation: */
-  double spacing;        /* sample spacing (sqrt of the median area per sample) */
-  double cell;           /* grid cell edge */
-  size_t dims[3];        /* grid cells per axis */
-  size_t cg_iterations;  /* summed over iterations */
-  double solve_seconds;  /* Poisson solves */
+  double spacing;         /* sample spacing (sqrt of the median area per sample) */
+  double cell;            /* grid cell edge */
+  size_t dims[3];         /* grid cells per axis */
+  size_t cg_iterations;   /* summed over iterations */
+  double solve_seconds;   /* Poisson solves */
   double extract_seconds; /* marching cubes */
-  double vote_seconds;   /* face k-NN, trimming, normal update */
-  size_t faces;          /* faces of the last iteration's mesh */
-  double final_change;   /* last convergence measure */
-  int converged;         /* 1 if it stopped on the convergence test */
-  size_t domain_cells;   /* cells the Poisson solve works on (<= dims product) */
+  double vote_seconds;    /* face k-NN, trimming, normal update */
+  size_t faces;           /* faces of the last iteration's mesh */
+  double final_change;    /* last convergence measure */
+  int converged;          /* 1 if it stopped on the convergence test */
+  size_t domain_cells;    /* cells the Poisson solve works on (<= dims product) */
 } dacpo_ipsr_stats;
 
 /* Refines the oriented normals nrm (3n, in/out) of a block's n samples; the
  * first n_own are the block's own points, the rest its ring. If mesh_out is
  * not NULL it receives the final trimmed mesh restricted to the own points,
- * wound to agree with the normals. */
+ * wound to agree with the normals (caller frees it with dacpo_mesh_free; it is
+ * zeroed first, and left empty on error or when no face remains).
+ * max_iterations 0 leaves the normals alone but still builds mesh_out.
+ * Blocks of fewer than 4 samples are left untouched (DACPO_OK, 0 iterations).
+ * Errors: INVALID_ARGUMENT (NULL, n_own > n, a bad parameter: the message
+ * names it), NONFINITE_INPUT (first bad sample's index), OUT_OF_MEMORY.
+ * Reentrant: no shared state, callable from several threads at once. */
 dacpo_status
 dacpo_ipsr_block(const double* xyz,
                  double* nrm,

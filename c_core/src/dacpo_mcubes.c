@@ -2,8 +2,10 @@
 /* Stage 3a': marching cubes on cell-centred grid values (paper §4.3: iPSR
  * extracts the iso-surface of the screened Poisson indicator each iteration).
  *
- * Inputs: a dacpo_grid, its values, an iso-value. Output: an indexed triangle
- * mesh whose face normals point towards values > iso.
+ * Inputs: a dacpo_grid, its values, an optional domain mask (only cubes whose
+ * 8 cells are in the domain are polygonised: the Poisson solver's narrow band),
+ * an iso-value. Output: an indexed triangle mesh whose face normals point
+ * towards values > iso.
  *
  * No case table is stored: each cube's polygons are built from its faces.
  * Walking each cube face counter-clockwise as seen from outside, a crossed
@@ -21,8 +23,10 @@
  *
  * Vertices are made once per crossed grid edge and looked up by edge through
  * two slabs of edge ids (the mesh is indexed, nothing is deduplicated later).
- * Cost: O(cells) with a tiny constant for empty cubes; memory O(nx*ny) scratch
- * plus the mesh. Failure modes: OUT_OF_MEMORY.
+ * A first pass codes every cell as outside / low / high in one byte and marks
+ * rows without domain cells, so empty space costs a byte read per cell.
+ * Cost: O(cells) with a tiny constant for empty cubes; memory one byte per
+ * cell, O(nx*ny) slabs, and the mesh. Failure modes: OUT_OF_MEMORY.
  */
 #include "dacpo_mcubes.h"
 
@@ -43,8 +47,8 @@ struct dacpo_mcubes {
 
 /* Corners: bit 0 = +x, bit 1 = +y, bit 2 = +z. Faces: corners counter-clockwise
  * seen from outside the cube. */
-static const int kFace[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+static const int kFace[6][4] = {
+    {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
 
 /* Edge index of the cube edge joining corners a and b (differ in one bit):
  * 4 * axis + the other two bits of the lower corner. */
@@ -157,7 +161,8 @@ edge_vertex(dacpo_mcubes* mc,
   const size_t node[3] = {idx % nx, (idx / nx) % ny, idx / (nx * ny)};
   double* p = mc->mesh.vertices + 3 * mc->mesh.num_vertices;
   for (int a = 0; a < 3; ++a)
-    p[a] = g->origin[a] + ((double)node[a] + 0.5 + (a == axis ? (double)t : 0.0)) * g->cell;
+    p[a] = g->origin[a] +
+           ((double)node[a] + 0.5 + (a == axis ? (double)t : 0.0)) * g->cell;
   return (int32_t)mc->mesh.num_vertices++;
 }
 
@@ -178,8 +183,7 @@ row_edges(dacpo_mcubes* mc,
   const size_t stride = axis == 0 ? 1 : (axis == 1 ? nx : nx * ny);
   const uint8_t* code = mc->code + base;
   const int last = (axis == 1 && j + 1 >= ny) || (axis == 2 && k + 1 >= nz);
-  if (last || !mc->rowany[j + ny * k] ||
-      (axis == 1 && !mc->rowany[j + 1 + ny * k]) ||
+  if (last || !mc->rowany[j + ny * k] || (axis == 1 && !mc->rowany[j + 1 + ny * k]) ||
       (axis == 2 && !mc->rowany[j + ny * (k + 1)])) {
     memset(ids, 0xff, nx * sizeof(int32_t));
     return 1;
@@ -208,8 +212,8 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
                      const dacpo_mesh** mesh,
                      dacpo_err* err)
 {
-  DACPO_CHECK(err, mc && g && val && mesh, DACPO_ERR_INVALID_ARGUMENT,
-              "mcubes: NULL argument");
+  DACPO_CHECK(
+      err, mc && g && val && mesh, DACPO_ERR_INVALID_ARGUMENT, "mcubes: NULL argument");
   *mesh = &mc->mesh;
   mc->mesh.num_vertices = 0;
   mc->mesh.num_triangles = 0;
@@ -269,13 +273,19 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
     const int32_t* by[2] = {ey[kc & 1], ey[k & 1]};
     for (size_t j = 0; j + 1 < ny; ++j) {
       const uint8_t* ra = mc->rowany;
-      if (!ra[j + ny * kc] || !ra[j + 1 + ny * kc] || !ra[j + ny * k] || !ra[j + 1 + ny * k])
+      if (!ra[j + ny * kc] || !ra[j + 1 + ny * kc] || !ra[j + ny * k] ||
+          !ra[j + 1 + ny * k])
         continue;
       const uint8_t* c0 = mc->code + nx * (j + ny * kc);
       for (size_t i = 0; i + 1 < nx; ++i) {
-        const uint8_t cc[8] = {c0[i],           c0[i + 1],           c0[i + nx],
-                               c0[i + nx + 1],  c0[i + nxy],         c0[i + nxy + 1],
-                               c0[i + nxy + nx], c0[i + nxy + nx + 1]};
+        const uint8_t cc[8] = {c0[i],
+                               c0[i + 1],
+                               c0[i + nx],
+                               c0[i + nx + 1],
+                               c0[i + nxy],
+                               c0[i + nxy + 1],
+                               c0[i + nxy + nx],
+                               c0[i + nxy + nx + 1]};
         int mask = 0, inside = 1;
         for (int c = 0; c < 8; ++c) {
           inside &= cc[c] != 0;
@@ -285,16 +295,17 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
           continue;
         float v[8];
         for (int c = 0; c < 8; ++c) {
-          size_t idx = (i + (c & 1)) + nx * ((j + ((c >> 1) & 1)) + ny * (kc + ((c >> 2) & 1)));
+          size_t idx =
+              (i + (c & 1)) + nx * ((j + ((c >> 1) & 1)) + ny * (kc + ((c >> 2) & 1)));
           v[c] = val[idx] - iso;
         }
         int32_t vid[12];
         for (int e = 0; e < 4; ++e) {
           /* e's two bits are the lower corner's other two coordinates */
           const size_t lo = (size_t)(e & 1), hi = (size_t)(e >> 1);
-          vid[e] = bx[hi][i + nx * (j + lo)];          /* x edges: (y, z) */
-          vid[4 + e] = by[hi][(i + lo) + nx * j];      /* y edges: (x, z) */
-          vid[8 + e] = ez[(i + lo) + nx * (j + hi)];   /* z edges: (x, y) */
+          vid[e] = bx[hi][i + nx * (j + lo)];        /* x edges: (y, z) */
+          vid[4 + e] = by[hi][(i + lo) + nx * j];    /* y edges: (x, z) */
+          vid[8 + e] = ez[(i + lo) + nx * (j + hi)]; /* z edges: (x, y) */
         }
         int next[12], segface[12];
         for (int e = 0; e < 12; ++e)

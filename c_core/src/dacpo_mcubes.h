@@ -23,9 +23,9 @@ dacpo_mcubes_free(dacpo_mcubes* mc);
  * Vertices lie on grid edges (one per crossed edge, shared by all triangles
  * using it, plus a centroid vertex for the rare loop that crosses an ambiguous
  * face twice): the mesh is indexed, consistently oriented and watertight
- * inside the grid; its only boundary is on the outermost layer of cell centres. Ambiguous cube faces
- * are resolved by the asymptotic decider, consistently for both cubes.
- * Winding: the face normal (v1-v0)x(v2-v0) points towards values > iso (for a
+ * inside the grid; its only boundary is on the outermost layer of cell centres.
+ * Ambiguous cube faces are resolved by the asymptotic decider, consistently for both
+ * cubes. Winding: the face normal (v1-v0)x(v2-v0) points towards values > iso (for a
  * dacpo_poisson chi: along the sample normals).
  * *mesh points into mc and stays valid until the next extract or free.
  * Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */

@@ -40,6 +40,7 @@ typedef struct run_state {
   dacpo_blocks blocks;
   dacpo_block_graph bgraph;
   double* oriented;        /* 3n: normals after stages 2-3, before flips */
+  double* ring_oriented;   /* 3 per ring entry: each block's normals of its ring */
   dacpo_mesh* meshes;      /* per block, only for VCR weights */
   dacpo_ipsr_stats* ipsr;  /* per block */
   double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
@@ -62,6 +63,7 @@ run_state_free(run_state* s)
   dacpo_blocks_free(&s->blocks);
   dacpo_block_graph_free(&s->bgraph);
   free(s->oriented);
+  free(s->ring_oriented);
   free(s->ipsr);
   free(s->block_seconds);
   free(s->flips);
@@ -166,6 +168,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.final_sweep = s->p.dipole_final_sweep;
   dp.seed = s->p.seed;
   dp.stream = (uint64_t)b;
+  dp.noise_band = s->p.dipole_noise_band;
   double t0 = dacpo_now();
   st = dacpo_dipole_orient(xyz, nrm, n, &dp, sign, err);
   double t1 = dacpo_now();
@@ -176,10 +179,12 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     for (int d = 0; d < 3; ++d)
       nrm[3 * i + d] *= (double)sign[i];
 
-  if (s->p.ipsr_enabled && n >= DACPO_MIN_IPSR_POINTS) {
+  /* With iPSR off but VCR weights on, one Poisson solve still gives the block
+   * its mesh (0 iterations: the normals are not changed). */
+  if ((s->p.ipsr_enabled || s->meshes) && n >= DACPO_MIN_IPSR_POINTS) {
     dacpo_ipsr_params ip;
     dacpo_ipsr_params_default(&ip);
-    ip.max_iterations = s->p.ipsr_max_iterations;
+    ip.max_iterations = s->p.ipsr_enabled ? s->p.ipsr_max_iterations : 0;
     st = dacpo_ipsr_block(xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b],
                           err);
     s->block_seconds[2 * b + 1] = dacpo_now() - t1;
@@ -188,6 +193,8 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   }
   for (size_t i = 0; i < no; ++i)
     memcpy(s->oriented + 3 * (size_t)bl->own[own0 + i], nrm + 3 * i, 3 * sizeof(double));
+  if (s->ring_oriented)
+    memcpy(s->ring_oriented + 3 * ring0, nrm + 3 * no, 3 * nr * sizeof(double));
 done:
   (void)thread_id;
   free(xyz);
@@ -371,11 +378,12 @@ run(dacpo_ctx* ctx,
   const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR;
   if (want_meshes)
     s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
-  if (!s->oriented || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes))
+  const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
+  if (want_ring)
+    s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
+  if (!s->oriented || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes) ||
+      (want_ring && !s->ring_oriented))
     return DACPO_OOM(err);
-  DACPO_CHECK(err, !want_meshes || s->p.ipsr_enabled, DACPO_ERR_INVALID_ARGUMENT,
-              "edge_weight VCR needs the stage 3 meshes: enable iPSR or use the "
-              "dipole-boundary weight");
   DACPO_TRY(dacpo_parallel_for(nb, s->p.num_threads, orient_block, s,
                                s->progress, s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
                                err));
@@ -401,6 +409,9 @@ run(dacpo_ctx* ctx,
   if (want_meshes)
     DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges, s->p.num_threads, weigh_edge_vcr, s,
                                  s->progress, DACPO_STAGE_EDGE_WEIGHTS, err));
+  else if (want_ring)
+    DACPO_TRY(dacpo_block_graph_overlap_weights(&s->bgraph, &s->blocks, s->oriented,
+                                                s->ring_oriented, err));
   else
     DACPO_TRY(dacpo_block_graph_dipole_weights(&s->bgraph, &s->cloud, &s->adj, &s->blocks,
                                                s->oriented, s->p.dipole_c, err));

@@ -72,15 +72,15 @@ typedef struct mg_level {
   size_t n[3];
   size_t cells;
   size_t active;
-  float c;         /* Laplacian face coefficient: cell edge in finest-cell units */
-  float* x;        /* levels >= 1: correction; level 0 uses the CG arrays */
-  float* b;        /* levels >= 1: restricted residual */
-  uint8_t* flags;  /* per cell, see F_* */
+  float c;        /* Laplacian face coefficient: cell edge in finest-cell units */
+  float* x;       /* levels >= 1: correction; level 0 uses the CG arrays */
+  float* b;       /* levels >= 1: restricted residual */
+  uint8_t* flags; /* per cell, see F_* */
   mg_run* runs;
   size_t nruns;
-  int32_t* srow;   /* screening row of each cell, or -1 */
-  float* sval;     /* 27 coefficients per screening row, offset (dx,dy,dz) at
-                      (dx+1) + 3 (dy+1) + 9 (dz+1) */
+  int32_t* srow; /* screening row of each cell, or -1 */
+  float* sval;   /* 27 coefficients per screening row, offset (dx,dy,dz) at
+                    (dx+1) + 3 (dy+1) + 9 (dz+1) */
   size_t rows;
   ptrdiff_t off[27]; /* index offset of each screening coefficient */
   ptrdiff_t nb[6];   /* index offset of each face neighbour */
@@ -89,11 +89,11 @@ typedef struct mg_level {
 struct dacpo_poisson {
   dacpo_grid grid;
   size_t n;
-  double* u;      /* 3n sample positions in finest-cell units from the origin */
-  double* w;      /* n screening weights alpha' * area (cell units) */
-  double* area;   /* n areas in cell units (splat weights) */
-  int32_t* sc;    /* 8n cell-centre interpolation cells on level 0 */
-  float* sw;      /* 8n weights */
+  double* u;    /* 3n sample positions in finest-cell units from the origin */
+  double* w;    /* n screening weights alpha' * area (cell units) */
+  double* area; /* n areas in cell units (splat weights) */
+  int32_t* sc;  /* 8n cell-centre interpolation cells on level 0 */
+  float* sw;    /* 8n weights */
   double wsum;
   size_t levels;
   mg_level lv[DACPO_POISSON_MAX_LEVELS];
@@ -122,7 +122,7 @@ dacpo_poisson_params_default(dacpo_poisson_params* p)
     return;
   p->cell_per_spacing = 1.0;
   p->max_resolution = 128;
-  p->max_cells = (size_t)1 << 21;
+  p->max_cells = 1500000; /* about 27 bytes per cell: <= 41 MB of grids */
   p->padding = 0.1;
   p->point_weight = 16.0;
   p->tolerance = 1e-3;
@@ -216,9 +216,11 @@ choose_grid(const double lo[3],
   if (emax <= 0.0)
     emax = h;
   for (int attempt = 0; attempt < 400; ++attempt) {
-    /* Padding: a share of the longest side, and at least two cells so that
-     * every sample's stencils stay inside the box. */
-    double pad = prm->padding * emax + 2.0 * h;
+    /* Padding: two cells so that every sample's stencils stay inside the
+     * box, plus the band; the whole-box domain (band 0) also gets a share of
+     * the longest side, room for the Neumann surface to run on. */
+    double pad =
+        prm->band ? (double)(prm->band + 2) * h : prm->padding * emax + 2.0 * h;
     size_t d[3], dmax = 0;
     for (int a = 0; a < 3; ++a) {
       double c = ceil((ext[a] + 2.0 * pad) / h);
@@ -267,7 +269,8 @@ choose_grid(const double lo[3],
  * two cells lo/hi and the weight f of hi, clamped to the grid (a clamped
  * weight folds onto the border cell, the Neumann reflection). */
 static void
-stencil_axes(const size_t n[3], const double u[3], size_t lo[3], size_t hi[3], double f[3])
+stencil_axes(
+    const size_t n[3], const double u[3], size_t lo[3], size_t hi[3], double f[3])
 {
   for (int a = 0; a < 3; ++a) {
     double t = u[a] - 0.5;
@@ -445,7 +448,8 @@ build_domain_coarse(dacpo_poisson* ps, size_t l, dacpo_err* err)
   int32_t cell[8];
   float wt[8];
   for (size_t s = 0; s < ps->n; ++s) {
-    double u[3] = {ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale, ps->u[3 * s + 2] * scale};
+    double u[3] = {
+        ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale, ps->u[3 * s + 2] * scale};
     cell_stencil(L->n, u, cell, wt);
     for (int c = 0; c < 8; ++c)
       L->flags[cell[c]] = 1;
@@ -466,8 +470,8 @@ build_screening(dacpo_poisson* ps, mg_level* L, double scale, dacpo_err* err)
   int32_t cell[8];
   float wt[8];
   for (size_t s = 0; s < ps->n; ++s) {
-    double u[3] = {ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale,
-                   ps->u[3 * s + 2] * scale};
+    double u[3] = {
+        ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale, ps->u[3 * s + 2] * scale};
     cell_stencil(L->n, u, cell, wt);
     for (int c = 0; c < 8; ++c)
       if (L->srow[cell[c]] < 0)
@@ -478,8 +482,8 @@ build_screening(dacpo_poisson* ps, mg_level* L, double scale, dacpo_err* err)
   if (!L->sval)
     return DACPO_OOM(err);
   for (size_t s = 0; s < ps->n; ++s) {
-    double u[3] = {ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale,
-                   ps->u[3 * s + 2] * scale};
+    double u[3] = {
+        ps->u[3 * s] * scale, ps->u[3 * s + 1] * scale, ps->u[3 * s + 2] * scale};
     size_t i0[3], i1[3];
     double f[3];
     stencil_axes(L->n, u, i0, i1, f);
@@ -519,8 +523,8 @@ cell_apply(const mg_level* L, const float* x, size_t idx)
   const float xc = x[idx];
   float acc;
   if (f == F_FULL)
-    acc = 6.0f * xc - (x[idx + nb[0]] + x[idx + nb[1]] + x[idx + nb[2]] + x[idx + nb[3]] +
-                       x[idx + nb[4]] + x[idx + nb[5]]);
+    acc = 6.0f * xc - (x[idx + nb[0]] + x[idx + nb[1]] + x[idx + nb[2]] +
+                       x[idx + nb[3]] + x[idx + nb[4]] + x[idx + nb[5]]);
   else {
     acc = 0.0f;
     for (int d = 0; d < 6; ++d)
@@ -547,8 +551,8 @@ cell_relax(const mg_level* L, float* x, const float* b, size_t idx)
   float sum;
   int cnt;
   if (f == F_FULL) {
-    sum = x[idx + nb[0]] + x[idx + nb[1]] + x[idx + nb[2]] + x[idx + nb[3]] + x[idx + nb[4]] +
-          x[idx + nb[5]];
+    sum = x[idx + nb[0]] + x[idx + nb[1]] + x[idx + nb[2]] + x[idx + nb[3]] +
+          x[idx + nb[4]] + x[idx + nb[5]];
     cnt = 6;
   }
   else {
@@ -619,7 +623,7 @@ diag_at(const mg_level* L, size_t idx)
  * coarse cell outside the box or the coarse domain is replaced by the parent
  * (Neumann reflection). Restriction is the transpose. */
 typedef struct prolong_row {
-  size_t row[4];  /* coarse row bases: (y near|far) x (z near|far) */
+  size_t row[4]; /* coarse row bases: (y near|far) x (z near|far) */
 } prolong_row;
 
 static inline size_t
@@ -645,8 +649,14 @@ prolong_row_of(const mg_level* F, const mg_level* C, size_t base, prolong_row* p
 }
 
 /* The 8 coarse cells of fine cell i of a row; weights are kCornerW. */
-static const float kCornerW[8] = {27.0f / 64, 9.0f / 64, 9.0f / 64, 3.0f / 64,
-                                  9.0f / 64,  3.0f / 64, 3.0f / 64, 1.0f / 64};
+static const float kCornerW[8] = {27.0f / 64,
+                                  9.0f / 64,
+                                  9.0f / 64,
+                                  3.0f / 64,
+                                  9.0f / 64,
+                                  3.0f / 64,
+                                  3.0f / 64,
+                                  1.0f / 64};
 
 static inline void
 coarse_corners(const mg_level* C, const prolong_row* pr, size_t i, size_t ci[8])
@@ -689,7 +699,8 @@ prolong_add(const mg_level* F, const mg_level* C, const float* xc, float* xf)
 /* coarse b = P^T (b - A x) on the fine level, fused so no fine residual array
  * is needed. */
 static void
-residual_restrict(const mg_level* F, const mg_level* C, const float* x, const float* b, float* bc)
+residual_restrict(
+    const mg_level* F, const mg_level* C, const float* x, const float* b, float* bc)
 {
   size_t ci[8];
   prolong_row pr;
@@ -789,7 +800,8 @@ vcycle(dacpo_poisson* ps, size_t l, float* x, const float* b)
   }
   mg_level* C = &ps->lv[l + 1];
   for (size_t r = 0; r < L->nruns; ++r)
-    memset(x + L->runs[r].base + L->runs[r].i0, 0,
+    memset(x + L->runs[r].base + L->runs[r].i0,
+           0,
            (L->runs[r].i1 - L->runs[r].i0) * sizeof(float));
   gauss_seidel(L, x, b, 0);
   gauss_seidel(L, x, b, 0);
@@ -815,35 +827,62 @@ dacpo_poisson_create(const double* xyz,
   *out = NULL;
   DACPO_CHECK(err, xyz && params, DACPO_ERR_INVALID_ARGUMENT, "poisson: NULL argument");
   DACPO_CHECK(err, n > 0, DACPO_ERR_INVALID_ARGUMENT, "poisson: no samples");
-  DACPO_CHECK(err, n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "poisson: %zu samples exceed int32 indices", n);
-  DACPO_CHECK(err, isfinite(spacing) && spacing > 0.0, DACPO_ERR_INVALID_ARGUMENT,
-              "poisson: spacing must be finite and > 0 (got %g)", spacing);
-  DACPO_CHECK(err, isfinite(params->cell_per_spacing) && params->cell_per_spacing > 0.0,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: cell_per_spacing must be > 0 (got %g)",
+  DACPO_CHECK(err,
+              n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: %zu samples exceed int32 indices",
+              n);
+  DACPO_CHECK(err,
+              isfinite(spacing) && spacing > 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: spacing must be finite and > 0 (got %g)",
+              spacing);
+  DACPO_CHECK(err,
+              isfinite(params->cell_per_spacing) && params->cell_per_spacing > 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: cell_per_spacing must be > 0 (got %g)",
               params->cell_per_spacing);
-  DACPO_CHECK(err, params->max_resolution >= 4 && params->max_resolution <= 4096,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: max_resolution must be in [4, 4096] (got %zu)",
+  DACPO_CHECK(err,
+              params->max_resolution >= 4 && params->max_resolution <= 4096,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: max_resolution must be in [4, 4096] (got %zu)",
               params->max_resolution);
-  DACPO_CHECK(err, params->max_cells >= 64 && params->max_cells <= (size_t)INT32_MAX,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: max_cells must be in [64, 2^31) (got %zu)",
+  DACPO_CHECK(err,
+              params->max_cells >= 64 && params->max_cells <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: max_cells must be in [64, 2^31) (got %zu)",
               params->max_cells);
-  DACPO_CHECK(err, isfinite(params->padding) && params->padding >= 0.0,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: padding must be >= 0 (got %g)",
+  DACPO_CHECK(err,
+              isfinite(params->padding) && params->padding >= 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: padding must be >= 0 (got %g)",
               params->padding);
-  DACPO_CHECK(err, isfinite(params->point_weight) && params->point_weight > 0.0,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: point_weight must be > 0 (got %g)",
+  DACPO_CHECK(err,
+              isfinite(params->point_weight) && params->point_weight > 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: point_weight must be > 0 (got %g)",
               params->point_weight);
-  DACPO_CHECK(err, isfinite(params->tolerance) && params->tolerance > 0.0,
-              DACPO_ERR_INVALID_ARGUMENT, "poisson: tolerance must be > 0 (got %g)",
+  DACPO_CHECK(err,
+              isfinite(params->tolerance) && params->tolerance > 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: tolerance must be > 0 (got %g)",
               params->tolerance);
+  DACPO_CHECK(err,
+              params->band <= 256,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: band must be <= 256 cells (got %zu)",
+              params->band);
 
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (size_t i = 0; i < n; ++i)
     for (int a = 0; a < 3; ++a) {
       double v = xyz[3 * i + a];
-      DACPO_CHECK(err, isfinite(v), DACPO_ERR_NONFINITE_INPUT,
-                  "poisson: sample %zu has a non-finite coordinate", i);
+      DACPO_CHECK(err,
+                  isfinite(v),
+                  DACPO_ERR_NONFINITE_INPUT,
+                  "poisson: sample %zu has a non-finite coordinate",
+                  i);
       if (v < lo[a])
         lo[a] = v;
       if (v > hi[a])
@@ -851,8 +890,12 @@ dacpo_poisson_create(const double* xyz,
     }
   if (area)
     for (size_t i = 0; i < n; ++i)
-      DACPO_CHECK(err, isfinite(area[i]) && area[i] >= 0.0, DACPO_ERR_INVALID_ARGUMENT,
-                  "poisson: area of sample %zu is %g", i, area[i]);
+      DACPO_CHECK(err,
+                  isfinite(area[i]) && area[i] >= 0.0,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "poisson: area of sample %zu is %g",
+                  i,
+                  area[i]);
 
   dacpo_poisson* ps = (dacpo_poisson*)calloc(1, sizeof(*ps));
   if (!ps)
@@ -863,9 +906,11 @@ dacpo_poisson_create(const double* xyz,
   ps->max_cg = params->max_cg_iterations ? params->max_cg_iterations : 1;
   dacpo_status st = DACPO_OK;
   if (!choose_grid(lo, hi, spacing, params, &ps->grid, &ps->levels)) {
-    st = dacpo_err_set(err, DACPO_ERR_INVALID_ARGUMENT,
+    st = dacpo_err_set(err,
+                       DACPO_ERR_INVALID_ARGUMENT,
                        "poisson: no grid fits max_resolution %zu and max_cells %zu",
-                       params->max_resolution, params->max_cells);
+                       params->max_resolution,
+                       params->max_cells);
     goto fail;
   }
   const dacpo_grid* g = &ps->grid;
@@ -911,13 +956,15 @@ dacpo_poisson_create(const double* xyz,
       L->n[a] = g->dims[a] >> l;
     L->cells = L->n[0] * L->n[1] * L->n[2];
     L->c = (float)((size_t)1 << l);
-    const ptrdiff_t sx = 1, sy = (ptrdiff_t)L->n[0], sz = (ptrdiff_t)(L->n[0] * L->n[1]);
+    const ptrdiff_t sx = 1, sy = (ptrdiff_t)L->n[0],
+                    sz = (ptrdiff_t)(L->n[0] * L->n[1]);
     for (int o = 0; o < 27; ++o)
       L->off[o] = (ptrdiff_t)(o % 3 - 1) * sx + (ptrdiff_t)((o / 3) % 3 - 1) * sy +
                   (ptrdiff_t)(o / 9 - 1) * sz;
     L->nb[0] = -sx, L->nb[1] = sx, L->nb[2] = -sy, L->nb[3] = sy, L->nb[4] = -sz,
     L->nb[5] = sz;
-    st = l == 0 ? build_domain0(ps, params->band, err) : build_domain_coarse(ps, l, err);
+    st =
+        l == 0 ? build_domain0(ps, params->band, err) : build_domain_coarse(ps, l, err);
     if (st != DACPO_OK)
       goto fail;
     if ((st = build_screening(ps, L, 1.0 / (double)((size_t)1 << l), err)) != DACPO_OK)
@@ -946,8 +993,8 @@ dacpo_poisson_create(const double* xyz,
   ps->cq = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
   ps->cz = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
   ps->cdiag = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  if (!ps->chi || !ps->r || !ps->z || !ps->p || !ps->q || !ps->cr || !ps->cp || !ps->cq ||
-      !ps->cz || !ps->cdiag) {
+  if (!ps->chi || !ps->r || !ps->z || !ps->p || !ps->q || !ps->cr || !ps->cp ||
+      !ps->cq || !ps->cz || !ps->cdiag) {
     st = DACPO_OOM(err);
     goto fail;
   }
@@ -974,7 +1021,8 @@ build_rhs(dacpo_poisson* ps, const double* nrm, float* b)
   const mg_level* L = &ps->lv[0];
   const size_t n0 = L->n[0], n1 = L->n[1], n2 = L->n[2];
   for (size_t r = 0; r < L->nruns; ++r)
-    memset(b + L->runs[r].base + L->runs[r].i0, 0,
+    memset(b + L->runs[r].base + L->runs[r].i0,
+           0,
            (L->runs[r].i1 - L->runs[r].i0) * sizeof(float));
   const long lim[3] = {(long)n0, (long)n1, (long)n2};
   for (size_t s = 0; s < ps->n; ++s) {
@@ -1048,7 +1096,8 @@ dacpo_poisson_solve(dacpo_poisson* ps,
                     dacpo_poisson_info* info,
                     dacpo_err* err)
 {
-  DACPO_CHECK(err, ps && nrm, DACPO_ERR_INVALID_ARGUMENT, "poisson_solve: NULL argument");
+  DACPO_CHECK(
+      err, ps && nrm, DACPO_ERR_INVALID_ARGUMENT, "poisson_solve: NULL argument");
   mg_level* L = &ps->lv[0];
   float *x = ps->chi, *r = ps->r, *z = ps->z, *p = ps->p, *q = ps->q;
   build_rhs(ps, nrm, r);

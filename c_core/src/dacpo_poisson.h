@@ -21,13 +21,14 @@ typedef struct dacpo_grid {
 typedef struct dacpo_poisson_params {
   double cell_per_spacing; /* cell edge / sample spacing (1.0) */
   size_t max_resolution;   /* cap on cells per axis (128) */
-  size_t max_cells;        /* cap on all cells, bounds memory (2^21) */
-  double padding;          /* box grows by this share of its longest side on every side (0.1) */
-  double point_weight;     /* screening alpha, PSR convention: relative to the box (4) */
-  double tolerance;        /* stop when |r| <= tolerance * |b| (1e-3) */
+  size_t max_cells;        /* cap on all cells, bounds memory (1.5e6, ~27 B each) */
+  double padding;          /* band 0 only: the box grows by this share of its longest
+                              side on every side (0.1); with a band, by band + 2 cells */
+  double point_weight; /* screening alpha, PSR convention: relative to the box (16) */
+  double tolerance;    /* stop when |r| <= tolerance * |b| (1e-3) */
   size_t max_cg_iterations; /* multigrid-preconditioned CG steps per solve (30) */
-  size_t band;             /* domain: cells within this many cells of a sample's
-                              stencil (Chebyshev; at least 2); 0 = the whole box (6) */
+  size_t band;              /* domain: cells within this many cells of a sample's
+                               stencil (Chebyshev; at least 2); 0 = the whole box (2) */
 } dacpo_poisson_params;
 
 void
@@ -40,7 +41,9 @@ typedef struct dacpo_poisson dacpo_poisson;
  * spacing^2); it weights both the normal splat and the screening. spacing > 0
  * is the typical sample distance; the cell is cell_per_spacing * spacing unless
  * a cap enlarges it.
- * Errors: INVALID_ARGUMENT (n == 0, bad params, non-finite data), OUT_OF_MEMORY. */
+ * Errors: INVALID_ARGUMENT (n == 0, bad params or areas), NONFINITE_INPUT (a
+ * non-finite coordinate, with its index), OUT_OF_MEMORY. One solver object is
+ * used by one thread at a time; separate objects are independent. */
 dacpo_status
 dacpo_poisson_create(const double* xyz,
                      const double* area,
@@ -54,9 +57,9 @@ void
 dacpo_poisson_free(dacpo_poisson* ps);
 
 typedef struct dacpo_poisson_info {
-  size_t iterations;       /* CG steps (one V-cycle each) */
-  double residual;         /* final |r| / |b| */
-  double iso_value;        /* area-weighted mean of chi at the samples */
+  size_t iterations; /* CG steps (one V-cycle each) */
+  double residual;   /* final |r| / |b| */
+  double iso_value;  /* area-weighted mean of chi at the samples */
 } dacpo_poisson_info;
 
 /* Solves (L + alpha S) chi = -div V + alpha S 1/2 for the normals nrm (3n,

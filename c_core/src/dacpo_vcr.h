@@ -23,7 +23,8 @@ typedef struct dacpo_vcr_params {
   double gap_fill_edges; /* 0.75: per view, the seam closing reaches at least
                             this many median triangle edges (converted to pixels,
                             at most DACPO_VCR_GAP_MAX): block meshes cut face by
-                            face leave seams about one face wide; 0 = off */
+                            face can leave seams about one face wide (the stage-3
+                            meshes of the 15 scans did not need it); 0 = off */
 } dacpo_vcr_params;
 
 /* Upper bound (pixels) of the seam closing chosen by gap_fill_edges. */
@@ -33,7 +34,12 @@ void
 dacpo_vcr_params_default(dacpo_vcr_params* p);
 
 /* alpha: view-alignment evidence with both meshes as they are; alpha_bar: the
- * same with mesh b's facing inverted (same z-buffer, labelled twice). */
+ * same with mesh b's facing inverted (same z-buffer, labelled twice).
+ * (Implementation notes: params NULL = defaults. alpha sums I = C_B*C1*C2 with
+ * C1, C2 divided by image_size^2 and C_B by image_size, so flipping b swaps
+ * alpha and alpha_bar exactly. Empty meshes: both 0, DACPO_OK. Errors:
+ * DACPO_ERR_INVALID_ARGUMENT (bad parameter, vertex index out of range,
+ * non-finite vertex), DACPO_ERR_OUT_OF_MEMORY. Thread-safe: scratch is per call.) */
 dacpo_status
 dacpo_vcr_edge(const dacpo_mesh* a,
                const dacpo_mesh* b,

@@ -3,19 +3,26 @@
  * open and thin surfaces, and (given PLY files with ground-truth normals, like
  * ../shared/data/ *.ply) blocks cut from real scans as the k nearest points of a
  * random seed. Every block starts from its true normals with a share flipped at
- * random. One line per block: grid, iterations, wall and CPU time (total and
- * per iteration; solve / marching cubes / vote split), peak bytes, and the
- * share of wrong normals before and after; then a summary.
+ * random. One line per block: grid, Poisson domain cells, iterations ('*' =
+ * stopped at max_iterations), CPU time of the block (this thread's clock, so
+ * other processes on the machine do not count) and the wall-clock split
+ * (setup, then per iteration: solve, marching cubes, vote), CPU per iteration,
+ * faces, peak bytes, and the share of wrong normals before and after; then a
+ * summary (iterations mean/max, block and per-iteration CPU mean/max).
  *
  * Not a test. Build (from the repository root):
  *   gcc -std=c11 -O2 -Ic_core/include -Ic_core/src -Itests/support \
- *       tests/c_core/bench_ipsr.c c_core/src/dacpo_ipsr.c c_core/src/dacpo_poisson.c \
- *       c_core/src/dacpo_mcubes.c c_core/src/dacpo_kdtree.c c_core/src/dacpo_context.c \
- *       tests/support/dacpo_ply.c -lm -o bench_ipsr
- * Usage: bench_ipsr [-n points] [-flip share] [-blocks per_scan] [-cps cell_per_spacing]
- *                   [-alpha point_weight] [-tol tolerance] [-maxres cells_per_axis]
- *                   [-maxcells cells] [-band cells] [-trim spacings] [-iters max]
- *                   [-gen kinds(0-5)] [-dump path_prefix] [file.ply ...] */
+ *     tests/c_core/bench_ipsr.c c_core/src/dacpo_ipsr.c \
+ *     c_core/src/dacpo_poisson.c c_core/src/dacpo_mcubes.c \
+ *     c_core/src/dacpo_kdtree.c c_core/src/dacpo_context.c \
+ *     tests/support/dacpo_ply.c -lm -o bench_ipsr
+ * Usage:
+ *   bench_ipsr [-n points] [-flip share] [-blocks per_scan]
+ *              [-cps cell_per_spacing] [-alpha point_weight] [-tol tolerance]
+ *              [-maxres cells_per_axis] [-maxcells cells] [-band cells]
+ *              [-trim spacings] [-iters max] [-noise sigma_in_spacings]
+ *              [-gen kinds(0-5)] [-dump path_prefix] [file.ply ...]
+ * e.g. bench_ipsr -blocks 4 ../shared/data/ *.ply (without the space). */
 #define _POSIX_C_SOURCE 200809L
 #include "dacpo_ipsr.h"
 #include "dacpo_kdtree.h"
@@ -56,7 +63,9 @@ wrong_percent(const double* n, const double* gt, size_t count)
 {
   size_t w = 0;
   for (size_t i = 0; i < count; ++i)
-    w += n[3 * i] * gt[3 * i] + n[3 * i + 1] * gt[3 * i + 1] + n[3 * i + 2] * gt[3 * i + 2] < 0;
+    w += n[3 * i] * gt[3 * i] + n[3 * i + 1] * gt[3 * i + 1] +
+             n[3 * i + 2] * gt[3 * i + 2] <
+         0;
   double pct = 100.0 * (double)w / (double)count;
   return pct < 50.0 ? pct : 100.0 - pct;
 }
@@ -72,7 +81,8 @@ block_alloc(block* b, const char* name, size_t n)
 }
 
 static void
-set_point(block* b, size_t i, double x, double y, double z, double nx, double ny, double nz)
+set_point(
+    block* b, size_t i, double x, double y, double z, double nx, double ny, double nz)
 {
   double l = sqrt(nx * nx + ny * ny + nz * nz);
   b->p[3 * i] = x, b->p[3 * i + 1] = y, b->p[3 * i + 2] = z;
@@ -84,12 +94,13 @@ set_point(block* b, size_t i, double x, double y, double z, double nx, double ny
 static int
 generate(block* b, int kind, size_t n, dacpo_rng* rng)
 {
-  static const char* names[] = {"wavy_sheet", "half_cylinder", "thin_board", "room_corner",
-                                "s_sheet"};
+  static const char* names[] = {
+      "wavy_sheet", "half_cylinder", "thin_board", "room_corner", "s_sheet"};
   if (!block_alloc(b, names[kind], n))
     return 0;
   for (size_t i = 0; i < n; ++i) {
-    double u = dacpo_rng_uniform(rng), v = dacpo_rng_uniform(rng), w = dacpo_rng_uniform(rng);
+    double u = dacpo_rng_uniform(rng), v = dacpo_rng_uniform(rng),
+           w = dacpo_rng_uniform(rng);
     switch (kind) {
     case 0: {
       double x = 2 * u - 1, y = 2 * v - 1;
@@ -114,11 +125,14 @@ generate(block* b, int kind, size_t n, dacpo_rng* rng)
         r -= a[f++];
       double s1 = u - 0.5, s2 = v - 0.5;
       if (f < 2)
-        set_point(b, i, sx * s1, sy * s2, f == 0 ? t / 2 : -t / 2, 0, 0, f == 0 ? 1 : -1);
+        set_point(
+            b, i, sx * s1, sy * s2, f == 0 ? t / 2 : -t / 2, 0, 0, f == 0 ? 1 : -1);
       else if (f < 4)
-        set_point(b, i, sx * s1, f == 2 ? sy / 2 : -sy / 2, t * s2, 0, f == 2 ? 1 : -1, 0);
+        set_point(
+            b, i, sx * s1, f == 2 ? sy / 2 : -sy / 2, t * s2, 0, f == 2 ? 1 : -1, 0);
       else
-        set_point(b, i, f == 4 ? sx / 2 : -sx / 2, sy * s1, t * s2, f == 4 ? 1 : -1, 0, 0);
+        set_point(
+            b, i, f == 4 ? sx / 2 : -sx / 2, sy * s1, t * s2, f == 4 ? 1 : -1, 0, 0);
       break;
     }
     case 3: {
@@ -166,7 +180,8 @@ generate(block* b, int kind, size_t n, dacpo_rng* rng)
       }
       else {
         double ang = kPi / 2 + t;
-        set_point(b, i, 0.5 * cos(ang), y, 1.5 + 0.5 * sin(ang), -cos(ang), 0, -sin(ang));
+        set_point(
+            b, i, 0.5 * cos(ang), y, 1.5 + 0.5 * sin(ang), -cos(ang), 0, -sin(ang));
       }
       break;
     }
@@ -177,8 +192,13 @@ generate(block* b, int kind, size_t n, dacpo_rng* rng)
 
 /* n nearest points of a random seed point of a scan. */
 static int
-cut_block(block* b, const char* name, const dacpo_ply_cloud* c, const dacpo_kdtree* tree,
-          const double* pts, size_t n, dacpo_rng* rng)
+cut_block(block* b,
+          const char* name,
+          const dacpo_ply_cloud* c,
+          const dacpo_kdtree* tree,
+          const double* pts,
+          size_t n,
+          dacpo_rng* rng)
 {
   if (!block_alloc(b, name, n))
     return 0;
@@ -192,8 +212,14 @@ cut_block(block* b, const char* name, const dacpo_ply_cloud* c, const dacpo_kdtr
   size_t got = dacpo_kdtree_knn(tree, pts + 3 * seed, n, idx, d2);
   for (size_t i = 0; i < got; ++i) {
     size_t j = (size_t)idx[i];
-    set_point(b, i, pts[3 * j], pts[3 * j + 1], pts[3 * j + 2], c->normals[3 * j],
-              c->normals[3 * j + 1], c->normals[3 * j + 2]);
+    set_point(b,
+              i,
+              pts[3 * j],
+              pts[3 * j + 1],
+              pts[3 * j + 2],
+              c->normals[3 * j],
+              c->normals[3 * j + 1],
+              c->normals[3 * j + 2]);
   }
   b->n = got;
   free(idx), free(d2);
@@ -236,8 +262,52 @@ dump_block(const block* b, const double* n, const dacpo_mesh* mesh)
   free(nf);
 }
 
+static int
+cmp_double(const void* a, const void* b)
+{
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+/* Displaces every point by sigma * (block spacing) * N(0,1) along a random
+ * direction (the paper's noise model), spacing = sqrt(median pi r_8^2 / 8). */
 static void
-run_block(const block* b, const dacpo_ipsr_params* prm, double flip, dacpo_rng* rng, summary* s)
+add_noise(block* b, double sigma, dacpo_rng* rng)
+{
+  dacpo_kdtree* tree = NULL;
+  dacpo_err err = {0};
+  double* a = malloc(b->n * sizeof(double));
+  if (!a || dacpo_kdtree_build(b->p, b->n, &tree, &err) != DACPO_OK) {
+    free(a);
+    return;
+  }
+  for (size_t i = 0; i < b->n; ++i) {
+    int32_t idx[9];
+    double d2[9];
+    size_t got = dacpo_kdtree_knn(tree, b->p + 3 * i, 9, idx, d2);
+    a[i] = got > 1 ? kPi * d2[got - 1] / (double)(got - 1) : 0.0;
+  }
+  qsort(a, b->n, sizeof(double), cmp_double);
+  const double s = sigma * sqrt(a[b->n / 2]);
+  dacpo_kdtree_free(tree);
+  free(a);
+  for (size_t i = 0; i < b->n; ++i) {
+    double u1 = dacpo_rng_uniform(rng), u2 = dacpo_rng_uniform(rng);
+    double g = sqrt(-2.0 * log(u1 > 1e-300 ? u1 : 1e-300)) * cos(2 * kPi * u2);
+    double z = 2 * dacpo_rng_uniform(rng) - 1, ph = 2 * kPi * dacpo_rng_uniform(rng);
+    double r = sqrt(1 - z * z);
+    b->p[3 * i] += s * g * r * cos(ph);
+    b->p[3 * i + 1] += s * g * r * sin(ph);
+    b->p[3 * i + 2] += s * g * z;
+  }
+}
+
+static void
+run_block(const block* b,
+          const dacpo_ipsr_params* prm,
+          double flip,
+          dacpo_rng* rng,
+          summary* s)
 {
   double* n = malloc(3 * b->n * sizeof(double));
   if (!n)
@@ -261,13 +331,33 @@ run_block(const block* b, const dacpo_ipsr_params* prm, double flip, dacpo_rng* 
   }
   double after = wrong_percent(n, b->gt, b->n);
   double it = st.iterations ? (double)st.iterations : 1.0;
-  printf("%-28s n %5zu grid %3zux%3zux%3zu it %2zu%s cg %3zu | wall %6.1f ms cpu %6.1f ms"
-         " | per it cpu %5.1f ms (solve %4.1f mc %4.1f vote %4.1f wall) | faces %6zu out %6zu"
-         " | peak %5.1f MB | wrong %5.1f%% -> %5.2f%%\n",
-         b->name, b->n, st.dims[0], st.dims[1], st.dims[2], st.iterations,
-         st.converged ? " " : "*", st.cg_iterations, 1e3 * st.seconds, 1e3 * cpu, 1e3 * cpu / it,
-         1e3 * st.solve_seconds / it, 1e3 * st.extract_seconds / it, 1e3 * st.vote_seconds / it,
-         st.faces, mesh.num_triangles, (double)st.peak_bytes / 1048576.0, before, after);
+  const double setup =
+      st.seconds - st.solve_seconds - st.extract_seconds - st.vote_seconds;
+  printf("%-28s n %5zu grid %3zux%3zux%3zu band %6zu it %2zu%s cg %3zu | cpu %5.0f ms"
+         " (wall %5.0f: setup %4.1f, per it solve %4.1f mc %4.1f vote %4.1f) | per it "
+         "cpu %5.1f"
+         " ms | faces %6zu out %6zu | peak %5.1f MB | wrong %5.1f%% -> %5.2f%%\n",
+         b->name,
+         b->n,
+         st.dims[0],
+         st.dims[1],
+         st.dims[2],
+         st.domain_cells,
+         st.iterations,
+         st.converged ? " " : "*",
+         st.cg_iterations,
+         1e3 * cpu,
+         1e3 * st.seconds,
+         1e3 * setup,
+         1e3 * st.solve_seconds / it,
+         1e3 * st.extract_seconds / it,
+         1e3 * st.vote_seconds / it,
+         1e3 * cpu / it,
+         st.faces,
+         mesh.num_triangles,
+         (double)st.peak_bytes / 1048576.0,
+         before,
+         after);
   fflush(stdout);
   dump_block(b, n, &mesh);
   s->blocks++;
@@ -298,13 +388,25 @@ print_summary(const char* title, const summary* s)
   if (!s->blocks)
     return;
   double k = (double)s->blocks;
-  printf("== %s: %zu blocks | iterations mean %.1f max %zu (not converged %zu) | block cpu "
-         "mean %.0f ms max %.0f ms (wall mean %.0f max %.0f) | per-iteration cpu mean %.1f ms "
+  printf("== %s: %zu blocks | iterations mean %.1f max %zu (not converged %zu) | block "
+         "cpu "
+         "mean %.0f ms max %.0f ms (wall mean %.0f max %.0f) | per-iteration cpu mean "
+         "%.1f ms "
          "max %.1f ms | peak max %.1f MB | wrong mean %.2f%% -> %.2f%%\n",
-         title, s->blocks, (double)s->iters / k, s->iters_max, s->unconverged,
-         1e3 * s->cpu / k, 1e3 * s->cpu_max, 1e3 * s->wall / k, 1e3 * s->wall_max,
-         1e3 * s->per_iter_cpu / k, 1e3 * s->per_iter_cpu_max,
-         (double)s->peak_max / 1048576.0, s->wrong_before / k, s->wrong_after / k);
+         title,
+         s->blocks,
+         (double)s->iters / k,
+         s->iters_max,
+         s->unconverged,
+         1e3 * s->cpu / k,
+         1e3 * s->cpu_max,
+         1e3 * s->wall / k,
+         1e3 * s->wall_max,
+         1e3 * s->per_iter_cpu / k,
+         1e3 * s->per_iter_cpu_max,
+         (double)s->peak_max / 1048576.0,
+         s->wrong_before / k,
+         s->wrong_after / k);
 }
 
 int
@@ -312,6 +414,7 @@ main(int argc, char** argv)
 {
   size_t n = 2500, per_scan = 4;
   int gen_kinds = 5;
+  double noise = 0.0;
   double flip = 0.3;
   dacpo_ipsr_params prm;
   dacpo_ipsr_params_default(&prm);
@@ -333,6 +436,8 @@ main(int argc, char** argv)
       prm.max_resolution = (size_t)atol(argv[++i]);
     else if (!strcmp(argv[i], "-maxcells") && i + 1 < argc)
       prm.max_cells = (size_t)atol(argv[++i]);
+    else if (!strcmp(argv[i], "-noise") && i + 1 < argc)
+      noise = atof(argv[++i]);
     else if (!strcmp(argv[i], "-dump") && i + 1 < argc)
       g_dump = argv[++i];
     else if (!strcmp(argv[i], "-band") && i + 1 < argc)
@@ -348,17 +453,27 @@ main(int argc, char** argv)
       break;
     }
   }
-  printf("bench_ipsr: n %zu, flipped %.0f%%, cell_per_spacing %g, point_weight %g, "
-         "max_resolution %zu, band %zu ('*' = stopped at max_iterations)\n",
-         n, 100 * flip, prm.cell_per_spacing, prm.point_weight, prm.max_resolution, prm.band);
+  printf("bench_ipsr: n %zu, flipped %.0f%%, noise %g spacings, cell_per_spacing %g, "
+         "point_weight %g, max_resolution %zu, band %zu, tolerance %g\n",
+         n,
+         100 * flip,
+         noise,
+         prm.cell_per_spacing,
+         prm.point_weight,
+         prm.max_resolution,
+         prm.band,
+         prm.tolerance);
   dacpo_rng rng;
   dacpo_rng_seed(&rng, 1, 3);
   summary gen = {0}, real = {0};
   for (int kind = 0; kind < gen_kinds; ++kind)
     for (int rep = 0; rep < 2; ++rep) {
       block b = {{0}, 0, NULL, NULL};
-      if (generate(&b, kind, n, &rng))
+      if (generate(&b, kind, n, &rng)) {
+        if (noise > 0.0)
+          add_noise(&b, noise, &rng);
         run_block(&b, &prm, flip, &rng, &gen);
+      }
       free(b.p), free(b.gt);
     }
   print_summary("generated", &gen);
@@ -367,7 +482,8 @@ main(int argc, char** argv)
     char msg[256];
     if (dacpo_ply_read(argv[f], &c, msg, sizeof(msg)) != DACPO_PLY_OK || !c.normals ||
         c.n < n) {
-      printf("%s: skipped (%s)\n", argv[f], c.normals ? msg : "no normals or too small");
+      printf(
+          "%s: skipped (%s)\n", argv[f], c.normals ? msg : "no normals or too small");
       dacpo_ply_cloud_free(&c);
       continue;
     }
@@ -386,8 +502,11 @@ main(int argc, char** argv)
           block b = {{0}, 0, NULL, NULL};
           char name[64];
           snprintf(name, sizeof(name), "%.24s#%zu", base, r);
-          if (cut_block(&b, name, &c, tree, pts, n, &rng))
+          if (cut_block(&b, name, &c, tree, pts, n, &rng)) {
+            if (noise > 0.0)
+              add_noise(&b, noise, &rng);
             run_block(&b, &prm, flip, &rng, &real);
+          }
           free(b.p), free(b.gt);
         }
       }

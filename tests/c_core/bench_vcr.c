@@ -101,13 +101,14 @@ main(int argc, char** argv)
   } v[6];
   for (int i = 0; i < 6; ++i)
     dacpo_vcr_params_default(&v[i].p);
-  v[0].name = "default (400, 12 views, ortho, C_B*C1*C2, gap 2)";
+  v[0].name = "default (400 px, 12 views, ortho, C_B*C1*C2)";
   v[1].name = "image 200";
   v[1].p.image_size = 200;
   v[2].name = "perspective";
   v[2].p.perspective = 1;
-  v[3].name = "gap_fill 0";
+  v[3].name = "no seam closing (gap_fill 0, gap_fill_edges 0)";
   v[3].p.gap_fill = 0;
+  v[3].p.gap_fill_edges = 0.0;
   v[4].name = "drop_partial";
   v[4].p.drop_partial = 1;
   v[5].name = "image 800";

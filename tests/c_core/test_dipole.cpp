@@ -53,7 +53,7 @@ jitter(dacpo_rng* rng, double amp)
 dacpo_dipole_params
 default_params()
 {
-  dacpo_dipole_params p;
+  dacpo_dipole_params p = {};
   p.c = 4.0;
   p.orders = 5;
   p.neighbors = 32;

@@ -22,15 +22,21 @@ const double kPi = 3.14159265358979323846;
 
 struct Cloud {
   std::vector<double> p, n, gt;
-  size_t size() const { return p.size() / 3; }
-  void add(double x, double y, double z, double nx, double ny, double nz)
+  size_t
+  size() const
+  {
+    return p.size() / 3;
+  }
+  void
+  add(double x, double y, double z, double nx, double ny, double nz)
   {
     double l = std::sqrt(nx * nx + ny * ny + nz * nz);
     p.insert(p.end(), {x, y, z});
     gt.insert(gt.end(), {nx / l, ny / l, nz / l});
   }
   // Initial normals: ground truth with a share flipped at random.
-  void flip(double share, uint32_t seed)
+  void
+  flip(double share, uint32_t seed)
   {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> U(0.0, 1.0);
@@ -42,11 +48,14 @@ struct Cloud {
   }
   // Percentage of normals more than 90 degrees from the truth, up to one
   // global sign (the paper's metric).
-  double wrong_percent() const
+  double
+  wrong_percent() const
   {
     size_t w = 0;
     for (size_t i = 0; i < size(); ++i)
-      w += n[3 * i] * gt[3 * i] + n[3 * i + 1] * gt[3 * i + 1] + n[3 * i + 2] * gt[3 * i + 2] < 0;
+      w += n[3 * i] * gt[3 * i] + n[3 * i + 1] * gt[3 * i + 1] +
+               n[3 * i + 2] * gt[3 * i + 2] <
+           0;
     double pct = 100.0 * (double)w / (double)size();
     return std::min(pct, 100.0 - pct);
   }
@@ -139,9 +148,10 @@ run(Cloud* c, const dacpo_ipsr_params& prm, IpsrRun* r, size_t n_own = 0)
   dacpo_err err{};
   if (n_own == 0)
     n_own = c->size();
-  ASSERT_EQ(dacpo_ipsr_block(c->p.data(), c->n.data(), c->size(), n_own, &prm, &r->mesh,
-                             &r->stats, &err),
-            DACPO_OK)
+  ASSERT_EQ(
+      dacpo_ipsr_block(
+          c->p.data(), c->n.data(), c->size(), n_own, &prm, &r->mesh, &r->stats, &err),
+      DACPO_OK)
       << err.msg;
 }
 
@@ -149,12 +159,13 @@ void
 centroid(const dacpo_mesh& m, size_t f, double c[3])
 {
   for (int a = 0; a < 3; ++a)
-    c[a] = (m.vertices[3 * m.triangles[3 * f] + a] + m.vertices[3 * m.triangles[3 * f + 1] + a] +
+    c[a] = (m.vertices[3 * m.triangles[3 * f] + a] +
+            m.vertices[3 * m.triangles[3 * f + 1] + a] +
             m.vertices[3 * m.triangles[3 * f + 2] + a]) /
            3.0;
 }
 
-}  // namespace
+} // namespace
 
 TEST(DacpoIpsr, WavySheetWithFlippedNormalsConverges)
 {
@@ -213,9 +224,9 @@ TEST(DacpoIpsr, ThinBoardKeepsItsTwoSidesOpposite)
 }
 
 struct HoleCounts {
-  size_t outside = 0;  // beyond the patch by more than the trimming distance + a cell
-  size_t in_hole = 0;  // over the big hole, farther than that from its rim
-  size_t in_gap = 0;   // over the small gap
+  size_t outside = 0; // beyond the patch by more than the trimming distance + a cell
+  size_t in_hole = 0; // over the big hole, farther than that from its rim
+  size_t in_gap = 0;  // over the small gap
 };
 
 HoleCounts
@@ -292,6 +303,39 @@ TEST(DacpoIpsr, TrimmingFloodsFromTheRimOnly)
   EXPECT_GT(count_hole_faces(r, 2.5 * r.stats.spacing, hole, gap).outside, 100u);
 }
 
+// A foreground patch 0.3 (7.5 cells) in front of a background plane, both facing +z, as
+// a depth scan sees an object before a wall. A Poisson indicator cannot step up twice
+// with one iso-value: over the whole box the two sheets fight through the free space
+// between them and the front one flips. In the narrow band (default) each sheet's
+// neighbourhood is its own domain and both keep their orientation; this is why the band
+// is the default.
+TEST(DacpoIpsr, StackedSheetsOfADepthScanKeepTheirOrientation)
+{
+  auto make = []() {
+    Cloud c;
+    const double step = 0.04;
+    for (double y = -1; y <= 1 + 1e-9; y += step)
+      for (double x = -1; x <= 1 + 1e-9; x += step)
+        c.add(x, y, 0.0, 0, 0, 1);
+    for (double y = -0.5; y <= 0.5 + 1e-9; y += step)
+      for (double x = -0.5; x <= 0.5 + 1e-9; x += step)
+        c.add(x + 0.013, y + 0.007, 0.3, 0, 0, 1);
+    c.n = c.gt;
+    return c;
+  };
+  Cloud band = make();
+  dacpo_ipsr_params prm;
+  dacpo_ipsr_params_default(&prm);
+  IpsrRun r;
+  run(&band, prm, &r);
+  EXPECT_EQ(band.wrong_percent(), 0.0);
+  Cloud box = make();
+  prm.band = 0; // the whole box
+  IpsrRun rb;
+  run(&box, prm, &rb);
+  EXPECT_GT(box.wrong_percent(), 5.0);
+}
+
 // After trimming, no face of an open sheet is far from the data: the check
 // that Neumann iPSR leaves no space-closing faces behind.
 TEST(DacpoIpsr, TrimmedMeshStaysNearTheData)
@@ -335,7 +379,11 @@ TEST(DacpoIpsr, MeshOutCoversOwnPointsAndAgreesWithNormals)
     if (all.p[3 * i] >= 0.3)
       order.push_back(i);
   for (size_t i : order)
-    c.add(all.p[3 * i], all.p[3 * i + 1], all.p[3 * i + 2], all.gt[3 * i], all.gt[3 * i + 1],
+    c.add(all.p[3 * i],
+          all.p[3 * i + 1],
+          all.p[3 * i + 2],
+          all.gt[3 * i],
+          all.gt[3 * i + 1],
           all.gt[3 * i + 2]);
   c.flip(0.2, 62);
   dacpo_ipsr_params prm;
@@ -367,7 +415,8 @@ TEST(DacpoIpsr, MeshOutCoversOwnPointsAndAgreesWithNormals)
     const double* d = r.mesh.vertices + 3 * t[2];
     double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double e2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    double nz[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+    double nz[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
                     e1[0] * e2[1] - e1[1] * e2[0]};
     const double* sn = c.n.data() + 3 * idx;
     agree += nz[0] * sn[0] + nz[1] * sn[1] + nz[2] * sn[2] > 0;
@@ -421,26 +470,69 @@ TEST(DacpoIpsr, RejectsBadInput)
   dacpo_ipsr_params_default(&prm);
   dacpo_ipsr_stats st;
   dacpo_err err{};
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 201, &prm, nullptr, &st, &err),
-            DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, nullptr, nullptr, &st, &err),
-            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 201, &prm, nullptr, &st, &err),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, nullptr, nullptr, &st, &err),
+      DACPO_ERR_INVALID_ARGUMENT);
   dacpo_ipsr_params bad = prm;
   bad.face_k = 0;
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, &bad, nullptr, &st, &err),
-            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, &bad, nullptr, &st, &err),
+      DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("face_k"), std::string::npos);
   bad = prm;
   bad.cell_per_spacing = 0;
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, &bad, nullptr, &st, &err),
-            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_ipsr_block(c.p.data(), c.n.data(), 200, 200, &bad, nullptr, &st, &err),
+      DACPO_ERR_INVALID_ARGUMENT);
   std::vector<double> nan_n = c.n;
   nan_n[3 * 17] = NAN;
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), nan_n.data(), 200, 200, &prm, nullptr, &st, &err),
-            DACPO_ERR_NONFINITE_INPUT);
+  EXPECT_EQ(
+      dacpo_ipsr_block(c.p.data(), nan_n.data(), 200, 200, &prm, nullptr, &st, &err),
+      DACPO_ERR_NONFINITE_INPUT);
   EXPECT_NE(std::string(err.msg).find("17"), std::string::npos);
   // tiny blocks are left alone
-  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 3, 3, &prm, nullptr, &st, &err), DACPO_OK);
+  EXPECT_EQ(dacpo_ipsr_block(c.p.data(), c.n.data(), 3, 3, &prm, nullptr, &st, &err),
+            DACPO_OK);
   EXPECT_EQ(st.iterations, 0u);
-  EXPECT_EQ(dacpo_ipsr_block(nullptr, nullptr, 0, 0, &prm, nullptr, &st, &err), DACPO_OK);
+  EXPECT_EQ(dacpo_ipsr_block(nullptr, nullptr, 0, 0, &prm, nullptr, &st, &err),
+            DACPO_OK);
+}
+
+// Degenerate blocks (coincident points, a line, zero normals) run without
+// error and leave finite unit or unchanged normals.
+TEST(DacpoIpsr, DegenerateBlocksStayFinite)
+{
+  dacpo_ipsr_params prm;
+  dacpo_ipsr_params_default(&prm);
+  for (int kind = 0; kind < 3; ++kind) {
+    Cloud c;
+    for (int i = 0; i < 300; ++i) {
+      if (kind == 0)
+        c.add(1, 2, 3, 0, 0, 1); // all coincident
+      else if (kind == 1)
+        c.add(0.01 * i, 0.02 * i, -0.01 * i, 0, 1, 0); // a line
+      else
+        c.add(0.05 * (i % 20), 0.05 * (i / 20), 0, 0, 0, 1); // a plane ...
+    }
+    c.n = c.gt;
+    if (kind == 2)
+      for (int i = 0; i < 300; i += 3)
+        c.n[3 * i] = c.n[3 * i + 1] = c.n[3 * i + 2] = 0; // ... a third without normals
+    IpsrRun r;
+    run(&c, prm, &r);
+    for (size_t i = 0; i < c.size(); ++i) {
+      double l = std::sqrt(c.n[3 * i] * c.n[3 * i] + c.n[3 * i + 1] * c.n[3 * i + 1] +
+                           c.n[3 * i + 2] * c.n[3 * i + 2]);
+      ASSERT_TRUE(std::isfinite(l)) << "kind " << kind << " point " << i;
+      ASSERT_TRUE(l == 0.0 || std::fabs(l - 1.0) < 1e-9) << "kind " << kind;
+    }
+    if (kind == 2) { // the plane's normals are all restored, +z
+      EXPECT_EQ(c.wrong_percent(), 0.0);
+      for (size_t i = 0; i < c.size(); ++i)
+        EXPECT_GT(c.n[3 * i + 2], 0.9);
+    }
+  }
 }

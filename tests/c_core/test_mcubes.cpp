@@ -27,14 +27,16 @@ struct Grid {
     g.cell = cell;
     v.assign(nx * ny * nz, 0.0f);
   }
-  void centre(size_t i, size_t j, size_t k, double p[3]) const
+  void
+  centre(size_t i, size_t j, size_t k, double p[3]) const
   {
     p[0] = g.origin[0] + (i + 0.5) * g.cell;
     p[1] = g.origin[1] + (j + 0.5) * g.cell;
     p[2] = g.origin[2] + (k + 0.5) * g.cell;
   }
   template <class F>
-  void fill(F f)
+  void
+  fill(F f)
   {
     for (size_t k = 0; k < g.dims[2]; ++k)
       for (size_t j = 0; j < g.dims[1]; ++j)
@@ -72,9 +74,9 @@ face_normal(const dacpo_mesh& m, size_t f, double n[3], double c[3])
 // Directed-edge census: a consistently oriented manifold has every directed
 // edge at most once, and its reverse present unless the edge is on the rim.
 struct EdgeCensus {
-  size_t duplicated = 0;  // a directed edge used twice (orientation clash)
-  size_t unpaired = 0;    // a directed edge whose reverse is missing (rim)
-  size_t edges = 0;       // undirected edges
+  size_t duplicated = 0; // a directed edge used twice (orientation clash)
+  size_t unpaired = 0;   // a directed edge whose reverse is missing (rim)
+  size_t edges = 0;      // undirected edges
 };
 
 EdgeCensus
@@ -97,16 +99,19 @@ census(const dacpo_mesh& m)
   return e;
 }
 
-}  // namespace
+} // namespace
 
 TEST(DacpoMcubes, SphereIsClosedAccurateAndWoundOutward)
 {
   Grid g(24, 24, 24, 0.1, -1.2, -1.2, -1.2);
   const double R = 0.83;
-  g.fill([](const double* p) { return std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]); });
+  g.fill([](const double* p) {
+    return std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  });
   MeshHolder h;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, R, &h.m, &err), DACPO_OK) << err.msg;
+  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, R, &h.m, &err), DACPO_OK)
+      << err.msg;
   ASSERT_GT(h.m.num_triangles, 500u);
   // Indexed and watertight: V - E + F = 2 for a sphere, no rim, no clashes.
   EdgeCensus e = census(h.m);
@@ -132,7 +137,7 @@ TEST(DacpoMcubes, SphereIsClosedAccurateAndWoundOutward)
 TEST(DacpoMcubes, PlaneFaceNormalsPointToHigherValues)
 {
   Grid g(10, 9, 8, 0.5, 0.0, 0.0, 0.0);
-  g.fill([](const double* p) { return 2.0 - p[2]; });  // high below z = 2 - iso
+  g.fill([](const double* p) { return 2.0 - p[2]; }); // high below z = 2 - iso
   MeshHolder h;
   dacpo_err err{};
   ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, 0.3, &h.m, &err), DACPO_OK);
@@ -146,7 +151,7 @@ TEST(DacpoMcubes, PlaneFaceNormalsPointToHigherValues)
   // Rim only on the outermost cell centres.
   EdgeCensus e = census(h.m);
   EXPECT_EQ(e.duplicated, 0u);
-  EXPECT_EQ(e.unpaired, 2u * (10 - 1) + 2u * (9 - 1));  // perimeter of a 9 x 8 quad grid
+  EXPECT_EQ(e.unpaired, 2u * (10 - 1) + 2u * (9 - 1)); // perimeter of a 9 x 8 quad grid
 }
 
 // Random fields exercise every cube case, the ambiguous faces included: the
@@ -164,7 +169,8 @@ TEST(DacpoMcubes, RandomFieldsGiveConsistentManifolds)
     for (float& x : g.v)
       x = U(rng);
     const dacpo_mesh* m = nullptr;
-    ASSERT_EQ(dacpo_mcubes_extract(mc, &g.g, g.v.data(), nullptr, 0.05, &m, &err), DACPO_OK);
+    ASSERT_EQ(dacpo_mcubes_extract(mc, &g.g, g.v.data(), nullptr, 0.05, &m, &err),
+              DACPO_OK);
     ASSERT_GT(m->num_triangles, 100u);
     EdgeCensus e = census(*m);
     EXPECT_EQ(e.duplicated, 0u) << "trial " << trial;
@@ -184,7 +190,8 @@ TEST(DacpoMcubes, RandomFieldsGiveConsistentManifolds)
     };
     for (const auto& kv : directed)
       if (!directed.count({kv.first.second, kv.first.first})) {
-        EXPECT_TRUE(on_outer(kv.first.first) && on_outer(kv.first.second)) << "trial " << trial;
+        EXPECT_TRUE(on_outer(kv.first.first) && on_outer(kv.first.second))
+            << "trial " << trial;
       }
     // Every vertex is used, and every vertex lies on a grid edge.
     std::vector<char> used(m->num_vertices, 0);
@@ -200,7 +207,8 @@ TEST(DacpoMcubes, RandomFieldsGiveConsistentManifolds)
 TEST(DacpoMcubes, OneVertexPerCrossedEdge)
 {
   Grid g(12, 11, 10, 0.2, -1.0, -1.0, -1.0);
-  g.fill([](const double* p) { return std::sin(3 * p[0]) + std::cos(2 * p[1]) * p[2]; });
+  g.fill(
+      [](const double* p) { return std::sin(3 * p[0]) + std::cos(2 * p[1]) * p[2]; });
   size_t crossed = 0;
   const size_t nx = 12, ny = 11, nz = 10;
   for (size_t k = 0; k < nz; ++k)
@@ -237,15 +245,18 @@ TEST(DacpoMcubes, EmptyAndDegenerateInputs)
   MeshHolder h;
   ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, 0.5, &h.m, &err), DACPO_OK);
   EXPECT_EQ(h.m.num_triangles, 0u);
-  Grid flat(5, 5, 1, 1.0, 0, 0, 0);  // a single layer has no cubes
+  Grid flat(5, 5, 1, 1.0, 0, 0, 0); // a single layer has no cubes
   MeshHolder h2;
-  ASSERT_EQ(dacpo_mcubes_run(&flat.g, flat.v.data(), nullptr, 0.5, &h2.m, &err), DACPO_OK);
+  ASSERT_EQ(dacpo_mcubes_run(&flat.g, flat.v.data(), nullptr, 0.5, &h2.m, &err),
+            DACPO_OK);
   EXPECT_EQ(h2.m.num_triangles, 0u);
-  EXPECT_EQ(dacpo_mcubes_run(nullptr, g.v.data(), nullptr, 0.5, &h.m, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_mcubes_run(nullptr, g.v.data(), nullptr, 0.5, &h.m, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   dacpo_mcubes* mc = nullptr;
   ASSERT_EQ(dacpo_mcubes_create(&mc, &err), DACPO_OK);
   const dacpo_mesh* m = nullptr;
-  EXPECT_EQ(dacpo_mcubes_extract(mc, &g.g, nullptr, nullptr, 0.5, &m, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_mcubes_extract(mc, &g.g, nullptr, nullptr, 0.5, &m, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   dacpo_mcubes_free(mc);
   dacpo_mcubes_free(nullptr);
 }

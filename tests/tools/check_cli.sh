@@ -10,6 +10,21 @@
 #   check_cli.sh must_fail PATTERN COMMAND...
 #       COMMAND must exit with status 1 (a clean failure, not a crash) and its
 #       stderr must contain PATTERN.
+#   check_cli.sh orient_diagnostics ORIENT in.ply labels.pcd edges.csv blocks.pcd STATS
+#       pcl_dacpo_orient -labels -edges -blocks_colored -q must succeed and print
+#       exactly one stderr line, "stats: ... peak_rss_mb=<number>", kept in STATS.
+#   check_cli.sh eval_blocks EVAL gt.ply labelled.pcd
+#       the JSON of pcl_dacpo_eval must have the block keys with sane values:
+#       intra_block_wrong_pct <= component_wrong_pct <= wrong_pct, and
+#       flip_wrong_blocks <= blocks.
+#   check_cli.sh edges_csv edges.csv STATS
+#       the CSV has the header and as many rows as "edges=" in STATS, each with 7
+#       columns and a confidence in [0, 1].
+#   check_cli.sh blocks_colored ORIENT blocks.pcd POINTS
+#       the PCD has x y z rgb and POINTS points, and pcl_dacpo_orient reads it.
+#   check_cli.sh known_blocks EVAL DIR
+#       known answer: 3 blocks of 100 points, one right, one flipped, one with 10
+#       points flipped: wrong 36.67 %, in-block 3.33 %, 1 flip-wrong block.
 #   check_cli.sh truncate SRC DST BYTES
 #       writes the first BYTES bytes of SRC to DST (a truncated input).
 #   check_cli.sh empty DST
@@ -19,6 +34,42 @@ set -u
 fail() {
   echo "FAIL: $*" >&2
   exit 1
+}
+
+# Numeric value of the first "key": in a JSON line.
+json_number() {
+  echo "$1" | grep -o "\"$2\":[0-9.eE+-]*" | head -1 | cut -d: -f2
+}
+
+# Succeeds if the awk expression over a and b holds.
+holds() {
+  awk -v a="$1" -v b="$2" "BEGIN { exit !($3) }"
+}
+
+# ASCII PLY of 300 points on the plane z = 0 (a 30 x 10 grid, spacing 0.01):
+# ground truth normal +z; predicted normals per block of 100 points: block 0
+# right, block 1 flipped, block 2 with its first 10 points flipped.
+write_known_blocks() {
+  local dir=$1
+  for kind in gt pred; do
+    {
+      echo "ply"
+      echo "format ascii 1.0"
+      echo "element vertex 300"
+      for p in x y z nx ny nz; do echo "property float $p"; done
+      [ "$kind" = pred ] && echo "property int block" && echo "property int component"
+      echo "end_header"
+      awk -v kind="$kind" 'BEGIN {
+        for (i = 0; i < 300; ++i) {
+          b = int(i / 100); nz = 1;
+          if (kind == "pred" && (b == 1 || (b == 2 && i % 100 < 10))) nz = -1;
+          line = sprintf("%g %g 0 0 0 %d", (i % 30) * 0.01, int(i / 30) * 0.01, nz);
+          if (kind == "pred") line = line " " b " 0";
+          print line;
+        }
+      }'
+    } >"$dir/known_$kind.ply" || fail "cannot write $dir/known_$kind.ply"
+  done
 }
 
 case "${1:-}" in
@@ -57,6 +108,74 @@ must_fail)
   echo "$err"
   [ $rc -eq 1 ] || fail "expected exit status 1, got $rc"
   echo "$err" | grep -q -- "$pattern" || fail "stderr does not mention '$pattern'"
+  ;;
+orient_diagnostics)
+  [ $# -eq 7 ] || fail "orient_diagnostics needs ORIENT IN LABELS EDGES BLOCKS STATS"
+  rm -f "$4" "$5" "$6" "$7"
+  "$2" "$3" "$4" -labels -edges "$5" -blocks_colored "$6" -q 2>"$7" ||
+    fail "pcl_dacpo_orient exited with $?: $(cat "$7")"
+  cat "$7"
+  [ "$(wc -l <"$7")" -eq 1 ] || fail "with -q stderr must be the stats line only"
+  grep -q '^stats: points=[0-9]* blocks=[0-9]* edges=[0-9]* .*peak_rss_mb=[0-9][0-9.]*$' "$7" ||
+    fail "no stats line with peak_rss_mb"
+  ;;
+eval_blocks)
+  [ $# -eq 4 ] || fail "eval_blocks needs EVAL GT PRED"
+  json=$("$2" "$3" "$4" -json) || fail "pcl_dacpo_eval exited with $?"
+  echo "$json"
+  for key in blocks component_wrong_pct intra_block_wrong_pct flip_wrong_blocks \
+    flip_wrong_points_pct largest_block_wrong; do
+    echo "$json" | grep -q "\"$key\":" || fail "key $key missing"
+  done
+  wrong=$(json_number "$json" wrong_pct)
+  comp=$(json_number "$json" component_wrong_pct)
+  intra=$(json_number "$json" intra_block_wrong_pct)
+  fwb=$(json_number "$json" flip_wrong_blocks)
+  fwp=$(json_number "$json" flip_wrong_points_pct)
+  blocks=$(json_number "$json" blocks)
+  holds "$intra" "$comp" 'a >= 0 && a <= b + 1e-9' || fail "intra_block_wrong_pct $intra > component_wrong_pct $comp"
+  holds "$comp" "$wrong" 'a <= b + 1e-9' || fail "component_wrong_pct $comp > wrong_pct $wrong"
+  holds "$fwb" "$blocks" 'a <= b && b >= 1' || fail "flip_wrong_blocks $fwb vs blocks $blocks"
+  holds "$fwp" 100 'a >= 0 && a <= b' || fail "flip_wrong_points_pct $fwp out of range"
+  [ "$(echo "$json" | grep -o '"wrong_pct":' | wc -l)" -eq $((1 + (blocks < 5 ? blocks : 5))) ] ||
+    fail "largest_block_wrong should list min(5, blocks) blocks"
+  ;;
+edges_csv)
+  [ $# -eq 3 ] || fail "edges_csv needs EDGES STATS"
+  [ -s "$2" ] || fail "$2 missing or empty"
+  head -1 "$2"
+  [ "$(head -1 "$2")" = "block_a,block_b,alpha,alpha_bar,confidence,flipped_a,flipped_b" ] ||
+    fail "bad CSV header"
+  edges=$(sed -n 's/.* edges=\([0-9]*\) .*/\1/p' "$3")
+  [ -n "$edges" ] || fail "no edges= in $(cat "$3")"
+  rows=$(($(wc -l <"$2") - 1))
+  [ "$rows" -eq "$edges" ] || fail "$rows CSV rows, stats say $edges edges"
+  [ "$edges" -ge 1 ] || fail "expected block edges on the room scene"
+  awk -F, 'NR > 1 && (NF != 7 || $5 < 0 || $5 > 1 || $1 >= $2 || ($6 != 0 && $6 != 1)) {
+    print "bad row " NR ": " $0; bad = 1 } END { exit bad }' "$2" || fail "bad CSV rows"
+  ;;
+blocks_colored)
+  [ $# -eq 4 ] || fail "blocks_colored needs ORIENT BLOCKS POINTS"
+  header=$(head -c 400 "$3" | grep -a -E '^(FIELDS|POINTS)') || fail "$3 is not a PCD"
+  echo "$header"
+  echo "$header" | grep -q '^FIELDS x y z rgb' || fail "fields are not x y z rgb"
+  echo "$header" | grep -q "^POINTS $4\$" || fail "expected $4 points"
+  stats=$("$2" "$3" "$3.reoriented.pcd" -estimate -no_ipsr -q 2>&1) ||
+    fail "pcl_dacpo_orient cannot read $3: $stats"
+  echo "$stats" | grep -q "points=$4 " || fail "read back: $stats"
+  rm -f "$3.reoriented.pcd"
+  ;;
+known_blocks)
+  [ $# -eq 3 ] || fail "known_blocks needs EVAL DIR"
+  write_known_blocks "$3"
+  json=$("$2" "$3/known_gt.ply" "$3/known_pred.ply" -json) || fail "pcl_dacpo_eval exited with $?"
+  echo "$json"
+  for kv in '"wrong_pct":36.6667' '"component_wrong_pct":36.6667' \
+    '"intra_block_wrong_pct":3.3333' '"blocks":3' '"flip_wrong_blocks":1' \
+    '"flip_wrong_points_pct":33.3333' \
+    '"largest_block_wrong":\[{"id":1, "component":0, "points":100, "wrong_pct":100.00}, {"id":2, "component":0, "points":100, "wrong_pct":10.00}, {"id":0, "component":0, "points":100, "wrong_pct":0.00}\]'; do
+    echo "$json" | grep -q "$kv" || fail "expected $kv"
+  done
   ;;
 truncate)
   [ $# -eq 4 ] || fail "truncate needs SRC DST BYTES"

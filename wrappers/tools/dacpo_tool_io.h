@@ -228,12 +228,14 @@ removeFields(const pcl::PCLPointCloud2& in, std::initializer_list<const char*> n
   return out;
 }
 
-/** Copy of \a in with FLOAT32 fields appended after the existing ones;
- *  \a values holds names.size() floats per point. */
+/** Copy of \a in with 4-byte fields of one \a datatype (FLOAT32, INT32 or
+ *  UINT32) appended after the existing ones; \a values holds names.size()
+ *  4-byte values per point. */
 inline pcl::PCLPointCloud2
-appendFloatFields(const pcl::PCLPointCloud2& in,
-                  const std::vector<std::string>& names,
-                  const std::vector<float>& values)
+appendFields4(const pcl::PCLPointCloud2& in,
+              const std::vector<std::string>& names,
+              std::uint8_t datatype,
+              const void* values)
 {
   pcl::PCLPointCloud2 out;
   out.header = in.header;
@@ -247,7 +249,7 @@ appendFloatFields(const pcl::PCLPointCloud2& in,
     pcl::PCLPointField g;
     g.name = names[f];
     g.offset = in.point_step + static_cast<std::uint32_t>(4 * f);
-    g.datatype = pcl::PCLPointField::FLOAT32;
+    g.datatype = datatype;
     g.count = 1;
     out.fields.push_back(g);
   }
@@ -255,13 +257,50 @@ appendFloatFields(const pcl::PCLPointCloud2& in,
   out.row_step = out.point_step * out.width;
   const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
   out.data.resize(n * out.point_step);
+  const std::uint8_t* src = static_cast<const std::uint8_t*>(values);
   for (std::size_t i = 0; i < n; ++i) {
     if (in.point_step > 0)
       std::memcpy(
           &out.data[i * out.point_step], &in.data[i * in.point_step], in.point_step);
-    std::memcpy(&out.data[i * out.point_step + in.point_step],
-                &values[i * names.size()],
-                extra);
+    std::memcpy(&out.data[i * out.point_step + in.point_step], src + i * extra, extra);
+  }
+  return out;
+}
+
+/** Copy of \a in with FLOAT32 fields appended after the existing ones;
+ *  \a values holds names.size() floats per point. */
+inline pcl::PCLPointCloud2
+appendFloatFields(const pcl::PCLPointCloud2& in,
+                  const std::vector<std::string>& names,
+                  const std::vector<float>& values)
+{
+  return appendFields4(in, names, pcl::PCLPointField::FLOAT32, values.data());
+}
+
+/** Copy of \a in with INT32 fields appended after the existing ones;
+ *  \a values holds names.size() integers per point. */
+inline pcl::PCLPointCloud2
+appendInt32Fields(const pcl::PCLPointCloud2& in,
+                  const std::vector<std::string>& names,
+                  const std::vector<std::int32_t>& values)
+{
+  return appendFields4(in, names, pcl::PCLPointField::INT32, values.data());
+}
+
+/** Reads one named numeric field of every point as int32 (rounded toward
+ *  zero; NaN and out-of-range values become -1). The field must exist. */
+inline std::vector<std::int32_t>
+readInt32Field(const pcl::PCLPointCloud2& cloud, const char* name)
+{
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const pcl::PCLPointField& field = cloud.fields[pcl::getFieldIndex(cloud, name)];
+  std::vector<std::int32_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v =
+        readValue(&cloud.data[i * cloud.point_step + field.offset], field.datatype);
+    out[i] = std::isfinite(v) && v >= -2147483648.0 && v <= 2147483647.0
+                 ? static_cast<std::int32_t>(v)
+                 : -1;
   }
   return out;
 }

@@ -5,7 +5,13 @@
  * the largest connected component of the k = 10 nearest-neighbour graph only
  * (exact duplicates merged, graph symmetrized: the core's definition). A
  * predicted normal that is not finite, or exactly perpendicular, is wrong under
- * either sign (dacpo_score_oriented() in tests/support). */
+ * either sign (dacpo_score_oriented() in tests/support).
+ *
+ * When the prediction carries pcl_dacpo_orient -labels fields (block, and
+ * component), the error is split by where it comes from: inside the blocks
+ * (stages 2 and 3: wrong even with the best sign per block) or from block
+ * flips (edge weights and the 0-1 program: blocks whose majority is wrong under
+ * the best sign of their component). */
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
@@ -52,6 +58,149 @@ printHelp(int, char** argv)
   print_info("  {\"file\":..., \"points\":N, \"wrong_pct\":x, "
              "\"largest_component_points\":M,\n");
   print_info("   \"largest_component_wrong_pct\":y, \"components\":C}\n");
+  print_info(
+      "  If the prediction has a 'block' field (pcl_dacpo_orient -labels), also:\n");
+  print_info("   \"blocks\":B, \"component_wrong_pct\": with the best sign per "
+             "component,\n");
+  print_info("   \"intra_block_wrong_pct\": with the best sign per block (stage 2+3 "
+             "error),\n");
+  print_info("   \"flip_wrong_blocks\": blocks whose majority is wrong under their "
+             "component's\n");
+  print_info("   best sign, \"flip_wrong_points_pct\": %% of all points in them (stage "
+             "4+5 error),\n");
+  print_info("   \"largest_block_wrong\": the 5 blocks with most wrong points under "
+             "that sign,\n");
+  print_info("   [{\"id\":b, \"component\":c, \"points\":p, \"wrong_pct\":w}, "
+             "...]. Components come\n");
+  print_info("   from the 'component' field if present, else from the graph above.\n");
+}
+
+/* Where the wrong points are, given block labels (pcl_dacpo_orient -labels). */
+struct BlockReport {
+  std::size_t blocks = 0;
+  double component_wrong_pct = 0.0;
+  double intra_block_wrong_pct = 0.0;
+  std::size_t flip_wrong_blocks = 0;
+  double flip_wrong_points_pct = 0.0;
+  struct Worst {
+    std::int32_t id, component;
+    std::size_t points;
+    double wrong_pct;
+  };
+  std::vector<Worst> worst; /* up to 5, most wrong points first */
+};
+
+/* Same three states as the metric: 0 right as is, 1 right when flipped,
+ * 2 wrong either way (not finite or perpendicular). */
+unsigned
+scoreState(const float* gt, const float* pred, std::size_t i)
+{
+  const double d = static_cast<double>(gt[3 * i]) * pred[3 * i] +
+                   static_cast<double>(gt[3 * i + 1]) * pred[3 * i + 1] +
+                   static_cast<double>(gt[3 * i + 2]) * pred[3 * i + 2];
+  return d > 0.0 ? 0u : (d < 0.0 ? 1u : 2u);
+}
+
+/* Dense 0..max relabelling of the non-negative labels; negative stays -1. */
+std::size_t
+denseLabels(const std::vector<std::int32_t>& in,
+            std::vector<std::int32_t>& out,
+            std::vector<std::int32_t>& original)
+{
+  std::vector<std::int32_t> sorted;
+  for (std::int32_t v : in)
+    if (v >= 0)
+      sorted.push_back(v);
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  out.resize(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i)
+    out[i] = in[i] < 0 ? -1
+                       : static_cast<std::int32_t>(
+                             std::lower_bound(sorted.begin(), sorted.end(), in[i]) -
+                             sorted.begin());
+  original = sorted;
+  return sorted.size();
+}
+
+/* Points without a block (label < 0) count as wrong only when wrong under both
+ * signs, so intra_block_wrong_pct <= component_wrong_pct <= wrong_pct. */
+BlockReport
+blockReport(const std::vector<float>& gt,
+            const std::vector<float>& pred,
+            const std::vector<std::int32_t>& block_in,
+            const std::vector<std::int32_t>& component_in)
+{
+  const std::size_t n = block_in.size();
+  std::vector<std::int32_t> block, comp, block_id, comp_id;
+  const std::size_t nb = denseLabels(block_in, block, block_id);
+  const std::size_t nc = denseLabels(component_in, comp, comp_id);
+  std::vector<unsigned> state(n);
+  for (std::size_t i = 0; i < n; ++i)
+    state[i] = scoreState(gt.data(), pred.data(), i);
+
+  /* Best sign per component (0: as is, 1: flipped). */
+  std::vector<std::size_t> ccount(3 * nc, 0);
+  std::size_t unlabelled_wrong = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (comp[i] >= 0)
+      ++ccount[3 * comp[i] + state[i]];
+  std::vector<unsigned> csign(nc);
+  std::size_t comp_wrong = 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    /* Flip when more points are right flipped than as they are. */
+    csign[c] = ccount[3 * c] < ccount[3 * c + 1] ? 1u : 0u;
+    comp_wrong += std::min(ccount[3 * c], ccount[3 * c + 1]) + ccount[3 * c + 2];
+  }
+
+  /* Per block: points, wrong under its best sign, wrong under the signs of the
+   * points' components. */
+  std::vector<std::size_t> bcount(3 * nb, 0), bwrong(nb, 0);
+  std::vector<std::int32_t> bcomp(nb, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wrong_c =
+        comp[i] < 0 ? state[i] == 2 : (state[i] == 2 || state[i] != csign[comp[i]]);
+    if (comp[i] < 0)
+      comp_wrong += wrong_c;
+    if (block[i] < 0) {
+      unlabelled_wrong += state[i] == 2;
+      continue;
+    }
+    ++bcount[3 * block[i] + state[i]];
+    bwrong[block[i]] += wrong_c;
+    if (bcomp[block[i]] < 0 && comp[i] >= 0)
+      bcomp[block[i]] = comp_id[comp[i]];
+  }
+  BlockReport r;
+  r.blocks = nb;
+  std::size_t intra_wrong = unlabelled_wrong, flip_points = 0;
+  std::vector<std::size_t> order(nb);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const std::size_t* c = &bcount[3 * b];
+    const std::size_t points = c[0] + c[1] + c[2];
+    intra_wrong += std::min(c[0], c[1]) + c[2];
+    if (2 * bwrong[b] > points) {
+      ++r.flip_wrong_blocks;
+      flip_points += points;
+    }
+    order[b] = b;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return bwrong[a] > bwrong[b];
+  });
+  for (std::size_t k = 0; k < order.size() && k < 5; ++k) {
+    const std::size_t b = order[k];
+    const std::size_t points = bcount[3 * b] + bcount[3 * b + 1] + bcount[3 * b + 2];
+    r.worst.push_back({block_id[b],
+                       bcomp[b],
+                       points,
+                       points ? 100.0 * static_cast<double>(bwrong[b]) / points : 0.0});
+  }
+  const double scale = n ? 100.0 / static_cast<double>(n) : 0.0;
+  r.component_wrong_pct = scale * static_cast<double>(comp_wrong);
+  r.intra_block_wrong_pct = scale * static_cast<double>(intra_wrong);
+  r.flip_wrong_points_pct = scale * static_cast<double>(flip_points);
+  return r;
 }
 
 /* Disjoint sets with path halving and union by size. */
@@ -320,17 +469,47 @@ main(int argc, char** argv)
     }
   }
 
+  const bool has_blocks = dacpo_tool::hasFields(pred2, {"block"});
+  BlockReport br;
+  if (has_blocks)
+    br = blockReport(gt,
+                     pred,
+                     dacpo_tool::readInt32Field(pred2, "block"),
+                     dacpo_tool::hasFields(pred2, {"component"})
+                         ? dacpo_tool::readInt32Field(pred2, "component")
+                         : label);
+
   if (json) {
     std::printf(
         "{\"file\":%s, \"points\":%zu, \"wrong_pct\":%.4f, "
         "\"largest_component_points\":%zu, \"largest_component_wrong_pct\":%.4f, "
-        "\"components\":%zu}\n",
+        "\"components\":%zu",
         jsonString(files[1]).c_str(),
         n,
         pct_all,
         sizes[largest],
         pct_largest,
         components);
+    if (has_blocks) {
+      std::printf(", \"blocks\":%zu, \"component_wrong_pct\":%.4f, "
+                  "\"intra_block_wrong_pct\":%.4f, \"flip_wrong_blocks\":%zu, "
+                  "\"flip_wrong_points_pct\":%.4f, \"largest_block_wrong\":[",
+                  br.blocks,
+                  br.component_wrong_pct,
+                  br.intra_block_wrong_pct,
+                  br.flip_wrong_blocks,
+                  br.flip_wrong_points_pct);
+      for (std::size_t k = 0; k < br.worst.size(); ++k)
+        std::printf("%s{\"id\":%d, \"component\":%d, \"points\":%zu, "
+                    "\"wrong_pct\":%.2f}",
+                    k ? ", " : "",
+                    static_cast<int>(br.worst[k].id),
+                    static_cast<int>(br.worst[k].component),
+                    br.worst[k].points,
+                    br.worst[k].wrong_pct);
+      std::printf("]");
+    }
+    std::printf("}\n");
   }
   else {
     print_info("%s: ", files[1].c_str());
@@ -346,6 +525,30 @@ main(int argc, char** argv)
     print_info(" of ");
     print_value("%zu", sizes[largest]);
     print_info(" points\n");
+    if (has_blocks) {
+      print_info("  %zu blocks. Wrong with the best sign per component: ", br.blocks);
+      print_value("%.2f%%", br.component_wrong_pct);
+      print_info("; per block (in-block error, stages 2-3): ");
+      print_value("%.2f%%\n", br.intra_block_wrong_pct);
+      print_info("  Blocks flipped wrong (stages 4-5): ");
+      print_value("%zu", br.flip_wrong_blocks);
+      print_info(" of ");
+      print_value("%zu", br.blocks);
+      print_info(", holding ");
+      print_value("%.2f%%", br.flip_wrong_points_pct);
+      print_info(" of the points\n");
+      if (!br.worst.empty())
+        print_info("  Blocks with most wrong points:\n");
+      for (const BlockReport::Worst& w : br.worst) {
+        print_info("    block %5d (component %d): ",
+                   static_cast<int>(w.id),
+                   static_cast<int>(w.component));
+        print_value("%zu", w.points);
+        print_info(" points, ");
+        print_value("%.2f%%", w.wrong_pct);
+        print_info(" wrong\n");
+      }
+    }
   }
   return 0;
 }

@@ -2,7 +2,11 @@
 /* pcl_dacpo_orient: orient the normals of a .pcd/.ply scan with DACPO.
  * Laid out like PCL's tools/normal_estimation.cpp: printHelp, loadCloud,
  * compute, saveCloud, main. Every input field is kept; normal_x/y/z and
- * curvature are added (or replaced). */
+ * curvature are added (or replaced). Diagnostics for tuning: -labels adds the
+ * block, component and flip of every point, -edges writes the block-graph edge
+ * weights as CSV, -blocks_colored writes one colour per block (darker when the
+ * 0-1 program flipped it). A last "stats: ..." line (also with -q) gives the
+ * counts, time and peak memory. */
 #include <dacpo/dacpo.h>
 
 #include <pcl_dacpo/dacpo_normal_orientation.h>
@@ -14,12 +18,17 @@
 #include <pcl/point_types.h>
 
 #include "dacpo_tool_io.h"
+#include <sys/resource.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 using namespace pcl::console;
 
@@ -51,11 +60,30 @@ highlight(const char* text)
     print_highlight(stderr, "%s", text);
 }
 
+/* Edges whose confidence is below this are reported as weak (issue 4). */
+constexpr double kLowConfidence = 0.2;
+
 struct Options {
   dacpo_params params;
   bool estimate = false;
   bool quiet = false;
+  bool labels = false;        /* -labels: block, component, flip fields */
+  std::string edges;          /* -edges file.csv */
+  std::string blocks_colored; /* -blocks_colored file.{pcd,ply} */
 };
+
+/* What a run leaves for the diagnostics, in output (= input) point order. */
+struct Result {
+  std::size_t points = 0; /* input points, skipped ones included */
+  dacpo_stats stats;
+  std::vector<int> blocks, components;
+  std::vector<std::uint8_t> flips;
+  std::vector<dacpo_edge_info> edges;
+};
+
+/* Output fields written by -labels; dropped from the input in any case, since
+ * labels of an earlier run would be stale. */
+const std::vector<std::string> kLabelFields = {"block", "component", "flip"};
 
 void
 printHelp(int, char** argv)
@@ -84,9 +112,13 @@ printHelp(int, char** argv)
       "                     -blocks X   = number of blocks, 0 = automatic (default: ");
   print_value("%zu", d.num_blocks);
   print_info(")\n");
-  print_info("                     -c X        = dipole exponent c, 4 clean / 2 noisy "
-             "(default: ");
+  print_info("                     -c X        = dipole constant c (paper Eq. 1): 4 "
+             "clean, 2 noisy,\n"
+             "                                   1.2 single-view depth frames (default: ");
   print_value("%g", d.dipole_c);
+  print_info(")\n");
+  print_info("                     -band X     = dipole noise band, 0 = off (default: ");
+  print_value("%g", d.dipole_noise_band);
   print_info(")\n");
   print_info("                     -orders X   = randomized dipole propagation orders "
              "(default: ");
@@ -99,8 +131,12 @@ printHelp(int, char** argv)
   print_info(
       "                     -no_ipsr    = skip the iterative Poisson refinement\n");
   print_info(
-      "                     -weights S  = block edge weights: dipole | vcr (default: ");
-  print_value("%s", d.edge_weight == DACPO_WEIGHT_VCR ? "vcr" : "dipole");
+      "                     -weights S  = block edge weights: vcr | dipole | overlap "
+      "(default: ");
+  print_value("%s",
+              d.edge_weight == DACPO_WEIGHT_VCR
+                  ? "vcr"
+                  : (d.edge_weight == DACPO_WEIGHT_OVERLAP ? "overlap" : "dipole"));
   print_info(")\n");
   print_info(
       "                     -time_limit X = seconds for the 0-1 program (default: ");
@@ -113,8 +149,35 @@ printHelp(int, char** argv)
       "                     -threads X  = worker threads, 0 = all cores (default: ");
   print_value("%u", d.num_threads);
   print_info(")\n");
-  print_info("                     -q          = quiet: errors only\n");
+  print_info("                     -labels     = add int32 fields block, component "
+             "and flip\n");
+  print_info("                                   (flip = 1 if the 0-1 program flipped "
+             "the block;\n");
+  print_info("                                   all -1 for skipped points); then "
+             "pcl_dacpo_eval\n");
+  print_info("                                   splits the error into in-block and "
+             "block-flip parts\n");
+  print_info("                     -edges F.csv = write the block-graph edges: block_a,"
+             "block_b,\n");
+  print_info("                                   alpha,alpha_bar,confidence,flipped_a,"
+             "flipped_b;\n");
+  print_info(
+      "                                   list the weakest edges (confidence < ");
+  print_value("%g", kLowConfidence);
+  print_info(")\n");
+  print_info("                     -blocks_colored F.{pcd,ply} = PointXYZRGB, one "
+             "colour per block,\n");
+  print_info("                                   darker if flipped, grey if skipped\n");
+  print_info(
+      "                     -q          = quiet: errors and the final stats line "
+      "only\n");
+  print_info("  After a successful run the last line on stderr is always\n");
+  print_info("  \"stats: points=... blocks=... edges=... ... seconds=... "
+             "peak_rss_mb=...\".\n");
   print_info("\nExample:\n  %s scan.ply oriented.pcd -k 10\n", argv[0]);
+  print_info("  %s scan.ply oriented.pcd -labels -edges edges.csv "
+             "-blocks_colored blocks.pcd\n",
+             argv[0]);
   print_info("View the result with:\n");
   print_info("  pcl_viewer output.pcd -normals 10 -normals_scale 0.05\n");
 }
@@ -163,7 +226,8 @@ struct ProgressLine {
 bool
 compute(const pcl::PCLPointCloud2& input,
         const Options& options,
-        pcl::PCLPointCloud2& output)
+        pcl::PCLPointCloud2& output,
+        Result& result)
 {
   const std::size_t n = static_cast<std::size_t>(input.width) * input.height;
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
@@ -256,9 +320,17 @@ compute(const pcl::PCLPointCloud2& input,
   info(" | total ");
   value("%.3f\n", s.total_seconds);
 
+  result.points = n;
+  result.stats = s;
+  result.blocks = dacpo.getBlockLabels();
+  result.components = dacpo.getComponentLabels();
+  result.flips = dacpo.getBlockFlips();
+  result.edges = dacpo.getEdges();
+
   /* Keep every input field except the ones we write, then append ours. */
   pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(
-      input, {"normal_x", "normal_y", "normal_z", "curvature"});
+      input,
+      {"normal_x", "normal_y", "normal_z", "curvature", "block", "component", "flip"});
   std::vector<float> values(4 * n);
   for (std::size_t i = 0; i < n; ++i) {
     values[4 * i] = normals_out[i].normal_x;
@@ -269,7 +341,178 @@ compute(const pcl::PCLPointCloud2& input,
   output = dacpo_tool::appendFloatFields(
       stripped, {"normal_x", "normal_y", "normal_z", "curvature"}, values);
   output.is_dense = normals_out.is_dense && input.is_dense;
+  if (options.labels) {
+    if (result.blocks.size() != n || result.components.size() != n) {
+      print_error("Error: the run left no block labels\n");
+      return false;
+    }
+    std::vector<std::int32_t> labels(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int b = result.blocks[i];
+      labels[3 * i] = b;
+      labels[3 * i + 1] = result.components[i];
+      labels[3 * i + 2] = b >= 0 && static_cast<std::size_t>(b) < result.flips.size()
+                              ? result.flips[b]
+                              : -1;
+    }
+    const bool dense = output.is_dense;
+    output = dacpo_tool::appendInt32Fields(output, kLabelFields, labels);
+    output.is_dense = dense;
+  }
   return true;
+}
+
+bool
+blockFlipped(const Result& r, std::int32_t block)
+{
+  return block >= 0 && static_cast<std::size_t>(block) < r.flips.size() &&
+         r.flips[block] != 0;
+}
+
+/* Writes the block-graph edges as CSV and reports the weakest ones on stderr. */
+bool
+saveEdges(const std::string& filename, const Result& r)
+{
+  highlight("Saving ");
+  value("%s ", filename.c_str());
+  FILE* f = std::fopen(filename.c_str(), "w");
+  if (!f) {
+    info("\n");
+    print_error(
+        "Error: cannot write '%s': %s\n", filename.c_str(), std::strerror(errno));
+    return false;
+  }
+  std::fprintf(f, "block_a,block_b,alpha,alpha_bar,confidence,flipped_a,flipped_b\n");
+  for (const dacpo_edge_info& e : r.edges)
+    std::fprintf(f,
+                 "%d,%d,%.9g,%.9g,%.9g,%d,%d\n",
+                 static_cast<int>(e.block_a),
+                 static_cast<int>(e.block_b),
+                 e.alpha,
+                 e.alpha_bar,
+                 e.confidence,
+                 blockFlipped(r, e.block_a) ? 1 : 0,
+                 blockFlipped(r, e.block_b) ? 1 : 0);
+  const bool ok = !std::ferror(f);
+  if (std::fclose(f) != 0 || !ok) {
+    info("\n");
+    print_error("Error: cannot write '%s'\n", filename.c_str());
+    return false;
+  }
+  info("[done : ");
+  value("%zu", r.edges.size());
+  info(" edges]\n");
+
+  std::vector<std::size_t> order(r.edges.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return r.edges[a].confidence < r.edges[b].confidence;
+  });
+  const std::size_t low = static_cast<std::size_t>(
+      std::count_if(r.edges.begin(), r.edges.end(), [](const dacpo_edge_info& e) {
+        return e.confidence < kLowConfidence;
+      }));
+  info("Edges with confidence < %g: ", kLowConfidence);
+  value("%zu", low);
+  info(" of ");
+  value("%zu", r.edges.size());
+  info("%s\n", order.empty() ? "" : "; the weakest:");
+  for (std::size_t i = 0; i < order.size() && i < 10; ++i) {
+    const dacpo_edge_info& e = r.edges[order[i]];
+    info("  blocks %5d - %-5d alpha ",
+         static_cast<int>(e.block_a),
+         static_cast<int>(e.block_b));
+    value("%-10.4g", e.alpha);
+    info(" alpha_bar ");
+    value("%-10.4g", e.alpha_bar);
+    info(" confidence ");
+    value("%-8.4f", e.confidence);
+    info(" flipped ");
+    value("%d/%d\n",
+          blockFlipped(r, e.block_a) ? 1 : 0,
+          blockFlipped(r, e.block_b) ? 1 : 0);
+  }
+  return true;
+}
+
+/* Colour of a block: hues 0.618... apart (golden ratio) so neighbouring ids
+ * differ; saturation alternates; flipped blocks are darker. */
+void
+blockColor(std::int32_t block, bool flipped, std::uint8_t rgb[3])
+{
+  if (block < 0) {
+    rgb[0] = rgb[1] = rgb[2] = 128;
+    return;
+  }
+  const double h = std::fmod(0.13 + 0.6180339887498949 * block, 1.0) * 6.0;
+  const double s = (block & 1) ? 0.55 : 0.85;
+  const double v = flipped ? 0.45 : 0.95;
+  /* HSV to RGB: channel n in {5, 3, 1} is v - v s clamp(min(k, 4 - k), 0, 1)
+   * with k = (n + h) mod 6. */
+  const double n_of[3] = {5.0, 3.0, 1.0};
+  for (int ch = 0; ch < 3; ++ch) {
+    const double k = std::fmod(n_of[ch] + h, 6.0);
+    const double c = v - v * s * std::max(0.0, std::min({k, 4.0 - k, 1.0}));
+    rgb[ch] = static_cast<std::uint8_t>(std::lround(255.0 * c));
+  }
+}
+
+bool
+saveBlocksColored(const std::string& filename,
+                  const pcl::PCLPointCloud2& input,
+                  const Result& r)
+{
+  const std::size_t n = static_cast<std::size_t>(input.width) * input.height;
+  if (r.blocks.size() != n) {
+    print_error("Error: the run left no block labels\n");
+    return false;
+  }
+  const std::vector<float> xyz = dacpo_tool::readTriplet(input, "x", "y", "z");
+  pcl::PointCloud<pcl::PointXYZRGB> cloud;
+  cloud.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    pcl::PointXYZRGB& p = cloud[i];
+    p.x = xyz[3 * i];
+    p.y = xyz[3 * i + 1];
+    p.z = xyz[3 * i + 2];
+    std::uint8_t rgb[3];
+    blockColor(r.blocks[i], blockFlipped(r, r.blocks[i]), rgb);
+    p.r = rgb[0];
+    p.g = rgb[1];
+    p.b = rgb[2];
+  }
+  cloud.is_dense = input.is_dense;
+  pcl::PCLPointCloud2 cloud2;
+  pcl::toPCLPointCloud2(cloud, cloud2);
+  TicToc tt;
+  tt.tic();
+  highlight("Saving ");
+  value("%s ", filename.c_str());
+  std::string error;
+  if (!dacpo_tool::saveCloud2(filename, cloud2, error)) {
+    info("\n");
+    print_error("Error: %s\n", error.c_str());
+    return false;
+  }
+  info("[done, ");
+  value("%g", tt.toc());
+  info(" ms : ");
+  value("%zu", n);
+  info(" points, ");
+  value("%zu", r.flips.size());
+  info(" blocks]\n");
+  return true;
+}
+
+/* Peak resident memory of this process in MiB (Linux: ru_maxrss is in KiB). */
+double
+peakRssMb()
+{
+  struct rusage usage;
+  if (getrusage(RUSAGE_SELF, &usage) != 0)
+    return -1.0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 bool
@@ -302,7 +545,8 @@ parseOptions(int argc, char** argv, Options& o)
                 blocks = o.params.num_blocks, orders = o.params.dipole_orders,
                 ring = o.params.ring_hops, seed = o.params.seed,
                 threads = o.params.num_threads;
-  double c = o.params.dipole_c, time_limit = o.params.solver_time_limit;
+  double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
+         band = o.params.dipole_noise_band;
   if (!dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-normal_k", normal_k, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-blocks", blocks, error) ||
@@ -311,6 +555,7 @@ parseOptions(int argc, char** argv, Options& o)
       !dacpo_tool::parseUnsigned(argc, argv, "-seed", seed, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-threads", threads, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-c", c, error) ||
+      !dacpo_tool::parseDouble(argc, argv, "-band", band, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-time_limit", time_limit, error)) {
     print_error("Error: %s\n", error.c_str());
     return false;
@@ -328,6 +573,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.params.seed = seed;
   o.params.num_threads = static_cast<unsigned>(threads);
   o.params.dipole_c = c;
+  o.params.dipole_noise_band = band;
   o.params.solver_time_limit = time_limit;
   o.params.ipsr_enabled = find_switch(argc, argv, "-no_ipsr") ? 0 : 1;
   std::string weights;
@@ -336,13 +582,35 @@ parseOptions(int argc, char** argv, Options& o)
       o.params.edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
     else if (weights == "vcr")
       o.params.edge_weight = DACPO_WEIGHT_VCR;
+    else if (weights == "overlap")
+      o.params.edge_weight = DACPO_WEIGHT_OVERLAP;
     else {
-      print_error("Error: -weights must be dipole or vcr, got '%s'\n", weights.c_str());
+      print_error("Error: -weights must be vcr, dipole or overlap, got '%s'\n",
+                  weights.c_str());
       return false;
     }
   }
   o.estimate = find_switch(argc, argv, "-estimate");
   o.quiet = find_switch(argc, argv, "-q");
+  o.labels = find_switch(argc, argv, "-labels");
+  for (const char* name : {"-edges", "-blocks_colored"}) {
+    const int at = find_argument(argc, argv, name);
+    if (at < 0)
+      continue;
+    if (at + 1 >= argc || argv[at + 1][0] == '\0') {
+      print_error("Error: %s needs a file name\n", name);
+      return false;
+    }
+    (std::strcmp(name, "-edges") == 0 ? o.edges : o.blocks_colored) = argv[at + 1];
+  }
+  if (!o.blocks_colored.empty()) {
+    const std::string ext = dacpo_tool::extension(o.blocks_colored);
+    if (ext != ".pcd" && ext != ".ply") {
+      print_error("Error: -blocks_colored needs a .pcd or .ply file name, got '%s'\n",
+                  o.blocks_colored.c_str());
+      return false;
+    }
+  }
   o.params.estimate_normals = 0; /* decided per input in compute() */
   dacpo_params check = o.params;
   check.estimate_normals = 1;
@@ -365,7 +633,8 @@ main(int argc, char** argv)
     printHelp(argc, argv);
     return argc < 3 ? 1 : 0;
   }
-  const std::vector<std::string> files = dacpo_tool::fileArguments(argc, argv);
+  const std::vector<std::string> files =
+      dacpo_tool::fileArguments(argc, argv, {"-edges", "-blocks_colored"});
   if (files.size() != 2) {
     print_error("Need one input and one output file (.pcd or .ply), got %zu.\n",
                 files.size());
@@ -388,9 +657,35 @@ main(int argc, char** argv)
     return 1;
   }
   pcl::PCLPointCloud2 output;
-  if (!compute(cloud, options, output))
+  Result result;
+  if (!compute(cloud, options, output, result))
     return 1;
   if (!saveCloud(files[1], output))
     return 1;
+  if (!options.edges.empty() && !saveEdges(options.edges, result))
+    return 1;
+  if (!options.blocks_colored.empty() &&
+      !saveBlocksColored(options.blocks_colored, cloud, result))
+    return 1;
+
+  /* One machine-readable line, printed even with -q (benchmarks grep it). */
+  const dacpo_stats& s = result.stats;
+  const std::size_t low = static_cast<std::size_t>(std::count_if(
+      result.edges.begin(), result.edges.end(), [](const dacpo_edge_info& e) {
+        return e.confidence < kLowConfidence;
+      }));
+  std::fprintf(stderr,
+               "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
+               "components=%zu flipped=%zu solver_optimal=%d seconds=%.3f "
+               "peak_rss_mb=%.1f\n",
+               result.points,
+               s.num_blocks,
+               s.num_block_edges,
+               low,
+               s.num_components,
+               s.flipped_blocks,
+               s.solver_optimal ? 1 : 0,
+               s.total_seconds,
+               peakRssMb());
   return 0;
 }

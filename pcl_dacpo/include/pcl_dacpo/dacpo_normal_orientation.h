@@ -176,8 +176,9 @@ public:
     return params_.ring_hops;
   }
 
-  /** \brief Exponent c of the dipole field (paper Eq. 1): 4 clean, 2 noisy (default 4).
-   */
+  /** \brief Constant c of the dipole field (paper Eq. 1), > 1 (default 4). Larger
+   * values keep thin two-sided structures apart, smaller ones (e.g. 1.2 for
+   * single-view depth frames) resist noise. */
   void
   setDipoleC(double c)
   {
@@ -337,6 +338,21 @@ public:
   getMinComponentSize() const
   {
     return params_.min_component_size;
+  }
+
+  /** \brief Noise band of the dipole field (0 = off, default): neighbour pairs whose
+   * offsets along both normals are below this many times the block's noise scale
+   * count as coplanar. */
+  void
+  setDipoleNoiseBand(double band)
+  {
+    params_.dipole_noise_band = band;
+  }
+  /** \brief See setDipoleNoiseBand(). */
+  double
+  getDipoleNoiseBand() const
+  {
+    return params_.dipole_noise_band;
   }
 
   /**
