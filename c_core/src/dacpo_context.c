@@ -126,7 +126,7 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (p->num_threads > 1024)
     return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
   if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&
-      p->disconnected != DACPO_DISCONNECTED_ERROR)
+      p->disconnected != DACPO_DISCONNECTED_ERROR && p->disconnected != DACPO_DISCONNECTED_BRIDGE)
     return bad_field(message, size, "disconnected has an unknown value %d", (int)p->disconnected);
   return DACPO_OK;
 }

@@ -9,6 +9,7 @@
  * Failure modes: every stage's status is passed through unchanged; the caller's
  * normals are written only after everything succeeded. */
 #include "dacpo_block_graph.h"
+#include "dacpo_bridge.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
 #include "dacpo_ilp.h"
@@ -34,7 +35,8 @@ typedef struct run_state {
   dacpo_cloud cloud;
   dacpo_knn_graph knn;
   dacpo_adjacency adj;
-  int32_t* component;
+  int32_t* component;       /* component the stages work with (0 after bridging) */
+  int32_t* input_component; /* component of the k-NN graph, as reported */
   size_t num_components;
   float* curvature; /* per distinct point, only when estimated */
   dacpo_blocks blocks;
@@ -55,6 +57,7 @@ run_state_free(run_state* s)
   dacpo_knn_graph_free(&s->knn);
   dacpo_adjacency_free(&s->adj);
   free(s->component);
+  free(s->input_component);
   free(s->curvature);
   if (s->meshes)
     for (size_t b = 0; b < s->blocks.num_blocks; ++b)
@@ -120,6 +123,21 @@ build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo
               "the k-NN graph (k=%zu) has %zu connected components (largest: %zu of %zu "
               "points); their relative orientation is undefined",
               st->k_used, s->num_components, st->largest_component, n);
+  s->input_component = dacpo_malloc_array(n, sizeof(int32_t));
+  if (!s->input_component)
+    return DACPO_OOM(err);
+  memcpy(s->input_component, s->component, n * sizeof(int32_t));
+  if (s->num_components > 1 && s->p.disconnected == DACPO_DISCONNECTED_BRIDGE) {
+    /* Bridges change only the adjacency the later stages read (segmentation,
+     * block graph, dipole weights); the k-NN lists and PCA normals are kept. */
+    dacpo_adjacency bridged;
+    DACPO_TRY(dacpo_bridge_components(&s->cloud, &s->adj, s->component, s->num_components,
+                                      2, &bridged, &st->bridges_added, &st->longest_bridge,
+                                      err));
+    dacpo_adjacency_free(&s->adj);
+    s->adj = bridged;
+    s->num_components = 1;
+  }
   return DACPO_OK;
 }
 
@@ -296,7 +314,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip;
     for (int d = 0; d < 3; ++d)
       normals[3 * j + d] = (float)(sign * axis[d]);
-    ctx->point_component[j] = s->component[i];
+    ctx->point_component[j] = s->input_component[i];
     ctx->point_block[j] = s->blocks.block_of[i];
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];

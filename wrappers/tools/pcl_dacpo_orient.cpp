@@ -117,6 +117,10 @@ printHelp(int, char** argv)
              "                                   1.2 single-view depth frames (default: ");
   print_value("%g", d.dipole_c);
   print_info(")\n");
+  print_info("                     -bridge     = join disconnected parts along their "
+             "minimum spanning tree\n"
+             "                                   and orient them as one (default: each "
+             "part on its own)\n");
   print_info("                     -band X     = dipole noise band, 0 = off (default: ");
   print_value("%g", d.dipole_noise_band);
   print_info(")\n");
@@ -590,6 +594,8 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
+  if (find_switch(argc, argv, "-bridge"))
+    o.params.disconnected = DACPO_DISCONNECTED_BRIDGE;
   o.estimate = find_switch(argc, argv, "-estimate");
   o.quiet = find_switch(argc, argv, "-q");
   o.labels = find_switch(argc, argv, "-labels");

@@ -96,7 +96,11 @@ typedef enum dacpo_disconnected_policy {
    *  (each component is left with the sign its first block got). */
   DACPO_DISCONNECTED_SEPARATE = 0,
   /** Fail with ::DACPO_ERR_DISCONNECTED. */
-  DACPO_DISCONNECTED_ERROR = 1
+  DACPO_DISCONNECTED_ERROR = 1,
+  /** Join the components by bridge edges along their Euclidean minimum spanning
+   *  tree (closest point pairs, plus a few nearby pairs per bridge) and orient
+   *  the whole cloud as one; the bridges are counted in dacpo_stats. */
+  DACPO_DISCONNECTED_BRIDGE = 2
 } dacpo_disconnected_policy;
 
 /**
@@ -210,6 +214,8 @@ typedef struct dacpo_stats {
   double stage_seconds[DACPO_STAGE_COUNT];
   double total_seconds;
   size_t peak_block_points; /**< largest block incl. ring */
+  size_t bridges_added;     /**< bridge edges added (DACPO_DISCONNECTED_BRIDGE) */
+  double longest_bridge;    /**< length of the longest bridge edge */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -385,7 +385,15 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   if (const dacpo_edge_info* edges = dacpo_ctx_edges(ctx.get()))
     edges_.assign(edges, edges + stats_.num_block_edges);
 
-  if (stats_.num_components > 1)
+  if (stats_.num_components > 1 && stats_.bridges_added > 0)
+    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
+             "components; %zu bridge edges (longest %g) joined them and the cloud was "
+             "oriented as one.\n",
+             getClassName().c_str(),
+             stats_.num_components,
+             stats_.bridges_added,
+             stats_.longest_bridge);
+  else if (stats_.num_components > 1)
     PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
              "components (largest %zu points); each is oriented on its own, their "
              "relative sign is undefined.\n",
