@@ -69,30 +69,38 @@ room="$dir/room_${points}_s$seed.ply"
 "$tools/pcl_dacpo_orient" "$room" "$dir/dacpo.pcd" -estimate -q "${extra[@]}" 2>/dev/null
 "${peer_cmd[@]}" "$room" "$peer_out" 2>/dev/null
 pct() { # gt pred colored.pcd -> wrong %
-  "$tools/pcl_dacpo_eval" "$1" "$2" -colored "$3" -json | sed -n 's/.*"wrong_pct":\([0-9.]*\).*/\1/p' | tail -1
+  "$tools/pcl_dacpo_eval" "$1" "$2" -colored "$3" -json |
+    sed -n 's/.*"wrong_pct":\([0-9.]*\).*/\1/p' | tail -1 | awk '{printf "%.2f", $1}'
 }
 w_dacpo=$(pct "$room" "$dir/dacpo.pcd" "$dir/dacpo_colored.pcd")
 w_peer=$(pct "$room" "$peer_out" "$dir/peer_colored.pcd")
 
 # --- headless screenshots: one Xvfb session, pcl_viewer per cloud, grab the root window
 # Camera: pcl_viewer -cam "near,far/focal/position/view up/fovy/window size/window pos",
-# looking down into the open 6 x 5 m room from a corner.
+# looking down into the open 6 x 5 m room over its front wall.
 W=900; H=700
-cam="0.1,60/3,2.5,0.4/-1.8,-4.2,7.2/0,0,1/0.8575/$W,$H/0,0"
+cam="0.1,60/3,2.2,0.3/3,-2.1,10.0/0,0,1/0.8575/$W,$H/0,0"
 cat > "$dir/shoot.sh" <<EOF
 set -u
 shoot() { # cloud png
   pcl_viewer "\$1" -bc 1,1,1 -ps 2 -cam "$cam" > "\$2.log" 2>&1 &
   pid=\$!
-  for i in \$(seq 1 120); do grep -q "done" "\$2.log" 2>/dev/null && break; sleep 0.5; done
-  sleep 4
+  # pcl_viewer's stdout is block-buffered into the log: wait for the window, then a fixed settle time
+  for i in \$(seq 1 60); do grep -q "Loading" "\$2.log" 2>/dev/null && break; sleep 0.5; done
+  sleep 5
   import -window root -crop ${W}x${H}+0+0 "\$2"
   kill \$pid 2>/dev/null; wait \$pid 2>/dev/null
+  return 0
 }
+rm -f "$dir/dacpo.png" "$dir/peer.png"
 shoot "$dir/dacpo_colored.pcd" "$dir/dacpo.png"
 shoot "$dir/peer_colored.pcd" "$dir/peer.png"
+exit 0
 EOF
 xvfb-run -a -s "-screen 0 ${W}x${H}x24" bash "$dir/shoot.sh"
+for f in "$dir/dacpo.png" "$dir/peer.png"; do
+  [ -s "$f" ] || { echo "render: screenshot $f failed (see $f.log)" >&2; exit 1; }
+done
 
 label() { # png text
   convert "$1" -gravity north -font DejaVu-Sans -pointsize 24 -fill black \
@@ -100,8 +108,8 @@ label() { # png text
 }
 label "$dir/dacpo.png" "pcl_dacpo: ${w_dacpo}% wrong"
 label "$dir/peer.png" "$peer_title: ${w_peer}% wrong"
-convert "$dir/dacpo.png" "$dir/peer.png" +append -gravity south -background white -splice 0x34 \
-  -font DejaVu-Sans -pointsize 18 -fill '#333333' \
-  -annotate +0+8 "generated room, $points points, seed $seed, normals from PCA (k=16); blue = correct, red = wrong" \
-  "$out"
+convert "$dir/dacpo.png" "$dir/peer.png" +append \
+  \( -size $((2 * W))x36 xc:white -gravity center -font DejaVu-Sans -pointsize 18 -fill '#333333' \
+     -annotate +0+0 "generated room, $points points (seed $seed), PCA normals (k=16) oriented; blue = correct, red = wrong" \) \
+  -append "$out"
 echo "render: wrote $out (pcl_dacpo ${w_dacpo}% wrong, $peer_title ${w_peer}% wrong)"

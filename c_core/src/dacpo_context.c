@@ -58,7 +58,7 @@ dacpo_params_init(dacpo_params* p)
   p->estimate_normals = 0;
   p->num_blocks = 0;
   p->ring_hops = 3;
-  p->dipole_c = 4.0;
+  p->dipole_c = 1.5;
   p->dipole_orders = 5;
   p->dipole_neighbors = 32;
   p->dipole_final_sweep = 1;

@@ -114,7 +114,7 @@ printHelp(int, char** argv)
   print_info(")\n");
   print_info("                     -c X        = dipole constant c (paper Eq. 1): 4 "
              "clean, 2 noisy,\n"
-             "                                   1.2 single-view depth frames (default: ");
+             "                                   1.2-1.5 depth frames (default: ");
   print_value("%g", d.dipole_c);
   print_info(")\n");
   print_info("                     -bridge     = join disconnected parts along their "

@@ -176,7 +176,7 @@ public:
     return params_.ring_hops;
   }
 
-  /** \brief Constant c of the dipole field (paper Eq. 1), > 1 (default 4). Larger
+  /** \brief Constant c of the dipole field (paper Eq. 1), > 1 (default 1.5). Larger
    * values keep thin two-sided structures apart, smaller ones (e.g. 1.2 for
    * single-view depth frames) resist noise. */
   void
