@@ -5,7 +5,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${DACPO_BUILD_DIR:-$root/build}"
-"$root/scripts/build.sh" -DDACPO_BUILD_TESTS=OFF >/dev/null
+"$root/scripts/build.sh" >/dev/null
 out="$build/demo"
 mkdir -p "$out"
 tools="$build/wrappers"

@@ -3,6 +3,6 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${DACPO_BUILD_DIR:-$root/build}"
-"$root/scripts/build.sh" "$@"
+"$root/scripts/build.sh" -DDACPO_BUILD_TESTS=ON "$@"
 cd "$build"
 ctest --output-on-failure -j "$(nproc)"
