@@ -682,8 +682,8 @@ main(int argc, char** argv)
       }));
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
-               "components=%zu flipped=%zu solver_optimal=%d seconds=%.3f "
-               "peak_rss_mb=%.1f\n",
+               "components=%zu flipped=%zu solver_optimal=%d ipsr_iterations_mean=%.2f "
+               "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
                s.num_blocks,
                s.num_block_edges,
@@ -691,6 +691,10 @@ main(int argc, char** argv)
                s.num_components,
                s.flipped_blocks,
                s.solver_optimal ? 1 : 0,
+               s.num_blocks ? static_cast<double>(s.ipsr_iterations_total) /
+                                  static_cast<double>(s.num_blocks)
+                            : 0.0,
+               s.ipsr_iterations_max,
                s.total_seconds,
                peakRssMb());
   return 0;
