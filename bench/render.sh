@@ -79,7 +79,7 @@ w_peer=$(pct "$room" "$peer_out" "$dir/peer_colored.pcd")
 # Camera: pcl_viewer -cam "near,far/focal/position/view up/fovy/window size/window pos",
 # looking down into the open 6 x 5 m room over its front wall.
 W=900; H=700
-cam="0.1,60/3,2.2,0.3/3,-2.1,10.0/0,0,1/0.8575/$W,$H/0,0"
+cam="0.1,60/3,2.9,0.5/3,-2.4,11.5/0,0,1/0.8575/$W,$H/0,0"
 cat > "$dir/shoot.sh" <<EOF
 set -u
 shoot() { # cloud png
@@ -102,13 +102,13 @@ for f in "$dir/dacpo.png" "$dir/peer.png"; do
   [ -s "$f" ] || { echo "render: screenshot $f failed (see $f.log)" >&2; exit 1; }
 done
 
-label() { # png text
-  convert "$1" -gravity north -font DejaVu-Sans -pointsize 24 -fill black \
-    -annotate +0+14 "$2" "$1"
+label() { # png text: trim the white margin, title on top
+  convert "$1" -fuzz 4% -trim +repage -bordercolor white -border 30 -gravity north -background white \
+    -splice 0x40 -font DejaVu-Sans -pointsize 24 -fill black -annotate +0+14 "$2" "$1"
 }
 label "$dir/dacpo.png" "pcl_dacpo: ${w_dacpo}% wrong"
 label "$dir/peer.png" "$peer_title: ${w_peer}% wrong"
-convert "$dir/dacpo.png" "$dir/peer.png" +append \
+convert "$dir/dacpo.png" "$dir/peer.png" -background white -gravity center +append \
   \( -size $((2 * W))x36 xc:white -gravity center -font DejaVu-Sans -pointsize 18 -fill '#333333' \
      -annotate +0+0 "generated room, $points points (seed $seed), PCA normals (k=16) oriented; blue = correct, red = wrong" \) \
   -append "$out"

@@ -40,6 +40,7 @@ USAGE = """usage: bench/run_benchmark.sh [options]
   --accuracy         run the accuracy suite (default when neither --scaling nor --all)
   --scaling          run the scaling suite only
   --all              run both
+  --report           run nothing, rewrite results.md from results.json
   -b DIR             build directory (default: <repo>/build; configured and built if the tools
                      are missing)
   -w DIR             work directory for generated inputs and predictions (default: <build>/bench)
@@ -75,6 +76,7 @@ try:
         elif a == "--accuracy": opt["what"] = "accuracy"
         elif a == "--scaling": opt["what"] = "scaling"
         elif a == "--all": opt["what"] = "all"
+        elif a == "--report": opt["what"] = "report"
         elif a == "--no-real": opt["real"] = False
         elif a in ("-b", "-w", "-o", "--data", "--room-n", "--seeds", "--sizes", "--methods",
                    "--extra", "--threads", "--timeout", "--open3d-timeout"):
@@ -518,7 +520,10 @@ def accuracy_markdown(acc):
             return "—", None
         if not ok:
             stt = {r["status"] for r in runs if r["method"] == mk and r["variant"] == v}
-            return ("timeout" if stt & {"timeout", "skipped"} else "failed"), None
+            if "timeout" in stt:
+                lim = st["open3d_timeout_s"] if mk == "open3d" else st["timeout_s"]
+                return f"> {lim:g} s", None
+            return ("not run" if stt == {"skipped"} else "failed"), None
         m = mean(ok)
         return (f"{m:.2f}" if len(ok) == n else f"{m:.2f} ({len(ok)}/{n})"), (m if len(ok) == n else None)
 
@@ -581,8 +586,8 @@ def accuracy_markdown(acc):
         L.append(f"Open3D: `estimate_normals(KNN 16)` + `orient_normals_consistent_tangent_plane(10)`, "
                  f"time limit {st['open3d_timeout_s']:g} s per run; Open3D 0.16's orientation is far "
                  "superlinear on exactly planar synthetic surfaces (isl-org/Open3D#6482), so after a "
-                 "time-out it is not run on larger inputs of the same kind; (k/n) = mean over the k of n "
-                 "inputs it finished.\n")
+                 "time-out (\"> N s\") it is not run on larger inputs of the same kind (\"not run\"); "
+                 "(k/n) = mean over the k of n inputs it finished.\n")
 
     L.append("### Time and peak memory (mean wall seconds end to end incl. file I/O / max peak RSS MB)\n")
     head2 = ["Method", "Clean", "σ=0.004", "σ=0.008", "100K", "10K", f"Real scans ({n_real})"]
@@ -716,27 +721,39 @@ def scaling_markdown(sc):
 
 
 def meta_markdown(meta):
+    load = f"{meta['load_at_start']:.2f}" if meta.get("load_at_start") is not None else "?"
+    if meta.get("load_at_end") is not None:
+        load += f" at start, {meta['load_at_end']:.2f} at end"
     s = (f"Run {meta['date']} on {meta['cpu']} ({meta['cores']} cores, {meta['mem_gb']} GiB), "
-         f"{meta['os']}; commit {meta['commit'] or '?'}; load average at start "
-         f"{meta['load_at_start']:.2f}; command `{meta['command']}`.")
+         f"{meta['os']}; commit {meta['commit'] or '?'}; load average (1 min) {load}; "
+         f"command `{meta['command']}`.")
     return s
 
 
 # ---------------------------------------------------------------- main
 def main():
-    ensure_tools()
-    os.makedirs(work, exist_ok=True)
+    if what != "report":
+        ensure_tools()
+        os.makedirs(work, exist_ok=True)
     os.makedirs(opt["results"], exist_ok=True)
     rj = os.path.join(opt["results"], "results.json")
     try:
         allres = json.load(open(rj))
     except (OSError, ValueError):
         allres = {}
+    if what == "report" and not allres:
+        sys.exit(f"run_benchmark: no results in {rj}")
     meta = machine_info()
     if what in ("accuracy", "all"):
         allres["accuracy"] = run_accuracy(dict(meta))
     if what in ("scaling", "all"):
         allres["scaling"] = run_scaling(dict(meta))
+    for sec in ("accuracy", "scaling"):
+        if what in (sec, "all"):
+            try:
+                allres[sec]["meta"]["load_at_end"] = os.getloadavg()[0]
+            except OSError:
+                pass
     with open(rj + ".tmp", "w") as f:
         json.dump(allres, f, indent=1)
     os.replace(rj + ".tmp", rj)
@@ -752,6 +769,9 @@ def main():
     with open(os.path.join(opt["results"], "results.md"), "w") as f:
         f.write(text)
     # stdout: the tables of this invocation (without the long per-run list)
+    if what == "report":
+        print(re.sub(r"<details>.*?</details>\n", "", text, flags=re.S))
+        return
     out = [meta_markdown(meta) + "\n"]
     if what in ("accuracy", "all"):
         out.append(accuracy_markdown(allres["accuracy"]).split("<details>")[0])
