@@ -463,6 +463,27 @@ blockColor(std::int32_t block, bool flipped, std::uint8_t rgb[3])
 }
 
 bool
+saveCloud(const std::string& filename, const pcl::PCLPointCloud2& output)
+{
+  TicToc tt;
+  tt.tic();
+  highlight("Saving ");
+  value("%s ", filename.c_str());
+  std::string error;
+  if (!dacpo_tool::saveCloud2(filename, output, error)) {
+    info("\n");
+    print_error("Error: %s\n", error.c_str());
+    return false;
+  }
+  info("[done, ");
+  value("%g", tt.toc());
+  info(" ms : ");
+  value("%u", output.width * output.height);
+  info(" points]\n");
+  return true;
+}
+
+bool
 saveBlocksColored(const std::string& filename,
                   const pcl::PCLPointCloud2& input,
                   const Result& r)
@@ -489,24 +510,7 @@ saveBlocksColored(const std::string& filename,
   cloud.is_dense = input.is_dense;
   pcl::PCLPointCloud2 cloud2;
   pcl::toPCLPointCloud2(cloud, cloud2);
-  TicToc tt;
-  tt.tic();
-  highlight("Saving ");
-  value("%s ", filename.c_str());
-  std::string error;
-  if (!dacpo_tool::saveCloud2(filename, cloud2, error)) {
-    info("\n");
-    print_error("Error: %s\n", error.c_str());
-    return false;
-  }
-  info("[done, ");
-  value("%g", tt.toc());
-  info(" ms : ");
-  value("%zu", n);
-  info(" points, ");
-  value("%zu", r.flips.size());
-  info(" blocks]\n");
-  return true;
+  return saveCloud(filename, cloud2);
 }
 
 /* Peak resident memory of this process in MiB (Linux: ru_maxrss is in KiB). */
@@ -517,27 +521,6 @@ peakRssMb()
   if (getrusage(RUSAGE_SELF, &usage) != 0)
     return -1.0;
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
-bool
-saveCloud(const std::string& filename, const pcl::PCLPointCloud2& output)
-{
-  TicToc tt;
-  tt.tic();
-  highlight("Saving ");
-  value("%s ", filename.c_str());
-  std::string error;
-  if (!dacpo_tool::saveCloud2(filename, output, error)) {
-    info("\n");
-    print_error("Error: %s\n", error.c_str());
-    return false;
-  }
-  info("[done, ");
-  value("%g", tt.toc());
-  info(" ms : ");
-  value("%u", output.width * output.height);
-  info(" points]\n");
-  return true;
 }
 
 bool
