@@ -21,6 +21,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -209,19 +210,46 @@ loadCloud(const std::string& filename, pcl::PCLPointCloud2& cloud)
   return true;
 }
 
-/* Progress on one terminal line: "\r  dipole  42%". */
+/* Progress on one terminal line, shown once a run has taken more than a second:
+ * "\r  ipsr          42%  elapsed 3.1 s  stage left ~4.2 s". The time left is
+ * extrapolated from the stage's own progress. */
 struct ProgressLine {
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point start = Clock::now();
+  Clock::time_point stage_start = start;
   int last_stage = -1;
   int last_percent = -1;
+  bool shown = false;
   bool
   operator()(dacpo_stage stage, double fraction)
   {
+    const Clock::time_point now = Clock::now();
+    if (static_cast<int>(stage) != last_stage)
+      stage_start = now;
     const int percent = static_cast<int>(fraction * 100.0 + 0.5);
-    if (static_cast<int>(stage) == last_stage && percent == last_percent)
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    const double in_stage = std::chrono::duration<double>(now - stage_start).count();
+    if ((static_cast<int>(stage) == last_stage && percent == last_percent) ||
+        (!shown && elapsed < 1.0)) {
+      last_stage = static_cast<int>(stage);
       return true;
+    }
     last_stage = static_cast<int>(stage);
     last_percent = percent;
-    std::fprintf(stderr, "\r  %-12s %3d%%", dacpo_stage_name(stage), percent);
+    shown = true;
+    if (fraction > 0.02 && fraction < 1.0)
+      std::fprintf(stderr,
+                   "\r  %-12s %3d%%  elapsed %.1f s  stage left ~%.1f s   ",
+                   dacpo_stage_name(stage),
+                   percent,
+                   elapsed,
+                   in_stage * (1.0 - fraction) / fraction);
+    else
+      std::fprintf(stderr,
+                   "\r  %-12s %3d%%  elapsed %.1f s                    ",
+                   dacpo_stage_name(stage),
+                   percent,
+                   elapsed);
     std::fflush(stderr);
     return true;
   }
@@ -290,7 +318,7 @@ compute(const pcl::PCLPointCloud2& input,
   pcl::PointCloud<pcl::Normal> normals_out;
   dacpo.compute(normals_out);
   if (show_progress)
-    std::fprintf(stderr, "\r%30s\r", "");
+    std::fprintf(stderr, "\r%78s\r", "");
   if (normals_out.size() != n) {
     print_error("Error: orientation failed: %s: %s\n",
                 dacpo_status_string(dacpo.getLastStatus()),
