@@ -92,8 +92,11 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
     message[0] = '\0';
   if (!p)
     return bad_field(message, size, "params is NULL");
-  if (p->k < 1)
-    return bad_field(message, size, "k must be >= 1 (got %zu)", p->k);
+  if (p->k < 2)
+    return bad_field(message, size,
+                     "k must be >= 2 (got %zu): a 1-NN graph splits every surface into "
+                     "pairs",
+                     p->k);
   if (p->k > 1000)
     return bad_field(message, size, "k must be <= 1000 (got %zu)", p->k);
   if (p->estimate_normals && (p->normal_k < 3 || p->normal_k > 1000))

@@ -357,7 +357,8 @@ run(dacpo_ctx* ctx,
   } while (0)
 
   DACPO_TRY(report(s, DACPO_STAGE_INPUT, 0.0, err));
-  DACPO_CHECK(err, normals != NULL, DACPO_ERR_INVALID_ARGUMENT,
+  /* count == 0 first: empty std::vectors hand over NULL pointers */
+  DACPO_CHECK(err, count == 0 || normals != NULL, DACPO_ERR_INVALID_ARGUMENT,
               "normals is NULL: it is the buffer that receives the oriented normals");
   const float* given = s->p.estimate_normals ? NULL : normals;
   DACPO_TRY(dacpo_input_check(xyz, given, count, err));

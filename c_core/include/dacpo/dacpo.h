@@ -108,7 +108,7 @@ typedef enum dacpo_disconnected_policy {
  * ever appended.
  */
 typedef struct dacpo_params {
-  size_t k;          /**< k-NN graph size for segmentation/propagation (10) */
+  size_t k;          /**< k-NN graph size for segmentation/propagation, >= 2 (10) */
   size_t normal_k;   /**< neighbourhood of PCA normals when estimated (16) */
   int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
                              0: use the given normals as axes (default 0) */

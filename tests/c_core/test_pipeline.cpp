@@ -1,0 +1,605 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// dacpo_orient() end to end, through the public C API only, on synthetic scenes
+// with known normals (tests/support/dacpo_scene.h): orientation error against
+// ground truth, the per-point / per-block / per-edge results and stats the
+// context publishes, determinism (seed, thread count, caller's search), the
+// progress callback's contract, and that the output keeps the caller's axes.
+#include <dacpo/dacpo.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <set>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "dacpo_scene.h"
+
+namespace {
+
+struct CtxDeleter {
+  void
+  operator()(dacpo_ctx* c) const
+  {
+    dacpo_ctx_free(c);
+  }
+};
+using CtxPtr = std::unique_ptr<dacpo_ctx, CtxDeleter>;
+
+CtxPtr
+makeCtx()
+{
+  dacpo_ctx* c = nullptr;
+  EXPECT_EQ(dacpo_ctx_create(&c), DACPO_OK);
+  return CtxPtr(c);
+}
+
+// A generated scene that frees itself.
+struct Scene {
+  dacpo_scene s{};
+  Scene() = default;
+  Scene(const Scene&) = delete;
+  Scene&
+  operator=(const Scene&) = delete;
+  ~Scene() { dacpo_scene_free(&s); }
+};
+
+void
+generate(unsigned kind, size_t points, uint64_t seed, Scene* out)
+{
+  dacpo_scene_params sp;
+  dacpo_scene_params_init(&sp);
+  sp.kind = kind;
+  sp.target_points = points;
+  sp.seed = seed;
+  char err[256] = "";
+  ASSERT_EQ(dacpo_scene_generate(&sp, &out->s, err, sizeof(err)), 0) << err;
+  ASSERT_EQ(out->s.n, points);
+}
+
+// The scene's ground truth with half of the signs flipped.
+std::vector<float>
+scrambled(const Scene& sc, uint64_t seed)
+{
+  std::vector<float> n(3 * sc.s.n);
+  dacpo_scene_scramble_signs(&sc.s, n.data(), seed, 0.5);
+  return n;
+}
+
+// Everything one run leaves in the context, copied out.
+struct Result {
+  dacpo_status status = DACPO_ERR_INTERNAL;
+  std::string error;
+  std::vector<float> normals;
+  dacpo_stats stats{};
+  std::vector<int32_t> component, block;
+  std::vector<float> curvature; // empty when normals were given
+  std::vector<uint8_t> flips;
+  std::vector<dacpo_edge_info> edges;
+};
+
+Result
+orient(dacpo_ctx* ctx,
+       const dacpo_params& p,
+       const float* xyz,
+       std::vector<float> normals,
+       size_t n,
+       const dacpo_search* search = nullptr,
+       const dacpo_progress* progress = nullptr)
+{
+  Result r;
+  r.status = dacpo_orient(ctx, &p, search, progress, xyz, normals.data(), n);
+  r.error = dacpo_ctx_last_error(ctx);
+  r.normals = std::move(normals);
+  r.stats = *dacpo_ctx_stats(ctx);
+  if (r.status != DACPO_OK)
+    return r;
+  const size_t m = r.stats.input_points;
+  if (const int32_t* c = dacpo_ctx_point_components(ctx))
+    r.component.assign(c, c + m);
+  if (const int32_t* b = dacpo_ctx_point_blocks(ctx))
+    r.block.assign(b, b + m);
+  if (const float* k = dacpo_ctx_point_curvature(ctx))
+    r.curvature.assign(k, k + m);
+  if (const uint8_t* f = dacpo_ctx_block_flips(ctx))
+    r.flips.assign(f, f + r.stats.num_blocks);
+  if (const dacpo_edge_info* e = dacpo_ctx_edges(ctx))
+    r.edges.assign(e, e + r.stats.num_block_edges);
+  return r;
+}
+
+Result
+orientScene(const Scene& sc,
+            const dacpo_params& p,
+            const dacpo_search* search = nullptr,
+            const dacpo_progress* progress = nullptr)
+{
+  auto ctx = makeCtx();
+  std::vector<float> in = p.estimate_normals ? std::vector<float>(3 * sc.s.n, 0.0f)
+                                             : scrambled(sc, 7);
+  return orient(ctx.get(), p, sc.s.xyz, std::move(in), sc.s.n, search, progress);
+}
+
+// Percentage of wrong normals, one free sign for the whole scene.
+double
+wrongPercent(const Scene& sc, const Result& r)
+{
+  return dacpo_score_oriented(sc.s.normals, r.normals.data(), sc.s.n, nullptr, nullptr);
+}
+
+bool
+sameBits(const std::vector<float>& a, const std::vector<float>& b)
+{
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+dacpo_params
+defaults()
+{
+  dacpo_params p;
+  dacpo_params_init(&p);
+  return p;
+}
+
+// Brute-force k nearest neighbours over the caller's arrays, nearest first,
+// ties to the lower index, distances in double (as the core ranks them).
+struct BruteForce {
+  const float* xyz;
+  size_t n;
+};
+
+int
+bruteForceKnn(void* user, size_t query, size_t k, int32_t* idx, float* sqd, size_t* found)
+{
+  const auto* bf = static_cast<const BruteForce*>(user);
+  if (query >= bf->n)
+    return 1;
+  std::vector<std::pair<double, int32_t>> all(bf->n);
+  const float* q = bf->xyz + 3 * query;
+  for (size_t j = 0; j < bf->n; ++j) {
+    const float* x = bf->xyz + 3 * j;
+    double dx = double(q[0]) - x[0], dy = double(q[1]) - x[1], dz = double(q[2]) - x[2];
+    all[j] = {dx * dx + dy * dy + dz * dz, static_cast<int32_t>(j)};
+  }
+  const size_t m = std::min(k, bf->n);
+  std::partial_sort(all.begin(), all.begin() + m, all.end());
+  for (size_t j = 0; j < m; ++j) {
+    idx[j] = all[j].second;
+    sqd[j] = static_cast<float>(all[j].first);
+  }
+  *found = m;
+  return 0;
+}
+
+struct ProgressLog {
+  std::vector<std::pair<int, double>> calls;
+  std::thread::id caller = std::this_thread::get_id();
+  size_t off_thread = 0;
+};
+
+int
+logProgress(void* user, dacpo_stage stage, double fraction)
+{
+  auto* log = static_cast<ProgressLog*>(user);
+  log->calls.emplace_back(static_cast<int>(stage), fraction);
+  if (std::this_thread::get_id() != log->caller)
+    log->off_thread++;
+  return 0;
+}
+
+} // namespace
+
+// ---- known answers ---------------------------------------------------------
+
+// Measured (seed 1, 10K points, defaults): 0.000 % wrong with given and with
+// estimated normals, also for scene seeds 2-4; the 1 % bound leaves margin for
+// platform differences while catching any wrongly flipped wall or floor block
+// (the smallest wall is ~16 % of the points).
+TEST(DacpoPipeline, OpenBoxScrambledNormals)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Result r = orientScene(sc, defaults());
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  const double wrong = wrongPercent(sc, r);
+  RecordProperty("wrong_percent", std::to_string(wrong));
+  EXPECT_LT(wrong, 1.0);
+  EXPECT_EQ(r.stats.num_components, 1u);
+  EXPECT_GT(r.stats.num_blocks, 1u) << "the block graph and 0-1 program should be used";
+  EXPECT_TRUE(r.curvature.empty()) << "curvature is only published for estimated normals";
+}
+
+TEST(DacpoPipeline, OpenBoxEstimatedNormals)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  Result r = orientScene(sc, p);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  const double wrong = wrongPercent(sc, r);
+  RecordProperty("wrong_percent", std::to_string(wrong));
+  EXPECT_LT(wrong, 1.0);
+  ASSERT_EQ(r.curvature.size(), sc.s.n);
+}
+
+// Measured (30K points, defaults, given normals): 1.33 % wrong for scene seed 1
+// (the errors sit on the thin door jambs), 0 % for seeds 2-4, 2.34 % with
+// estimated normals. A wrongly flipped wall block alone costs > 3 %.
+TEST(DacpoPipeline, TwoRoomsBelowMeasuredError)
+{
+  Scene sc;
+  generate(DACPO_SCENE_TWO_ROOMS, 30000, 1, &sc);
+  Result r = orientScene(sc, defaults());
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  const double wrong = wrongPercent(sc, r);
+  RecordProperty("wrong_percent", std::to_string(wrong));
+  EXPECT_LT(wrong, 3.0);
+  EXPECT_GE(r.stats.num_blocks, 8u);
+  EXPECT_EQ(r.stats.solver_optimal, 1);
+}
+
+// ---- published results --------------------------------------------------------
+
+// Two copies of the box, 100 m apart, in a shuffled input order: every
+// per-point array must follow the input order.
+TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 8000, 2, &sc);
+  const size_t half = sc.s.n, n = 2 * half;
+  std::vector<size_t> perm(n);
+  for (size_t i = 0; i < n; ++i)
+    perm[i] = i;
+  uint64_t st = 12345;
+  for (size_t i = n - 1; i > 0; --i) { // Fisher-Yates with a fixed LCG
+    st = st * 6364136223846793005ull + 1442695040888963407ull;
+    std::swap(perm[i], perm[(st >> 33) % (i + 1)]);
+  }
+  std::vector<float> xyz(3 * n), gt(3 * n);
+  for (size_t j = 0; j < n; ++j) {
+    const size_t src = perm[j] % half;
+    const float shift = perm[j] < half ? 0.0f : 100.0f;
+    for (int a = 0; a < 3; ++a) {
+      xyz[3 * j + a] = sc.s.xyz[3 * src + a] + (a == 0 ? shift : 0.0f);
+      gt[3 * j + a] = sc.s.normals[3 * src + a];
+    }
+  }
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  auto ctx = makeCtx();
+  Result r = orient(ctx.get(), p, xyz.data(), std::vector<float>(3 * n, 0.0f), n);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  ASSERT_EQ(r.stats.input_points, n);
+  ASSERT_EQ(r.stats.num_components, 2u);
+  ASSERT_EQ(r.component.size(), n);
+  ASSERT_EQ(r.block.size(), n);
+  ASSERT_EQ(r.curvature.size(), n);
+
+  // components: ids in order of first input point, so point 0's is 0
+  const bool first_far = xyz[0] > 50.0f;
+  for (size_t j = 0; j < n; ++j)
+    ASSERT_EQ(r.component[j], (xyz[3 * j] > 50.0f) != first_far ? 1 : 0) << j;
+  // each box oriented on its own, one free sign per component
+  EXPECT_LT(dacpo_score_oriented(gt.data(), r.normals.data(), n, r.component.data(), nullptr),
+            1.0);
+
+  // blocks: valid ids, all used, none spanning components, spatially compact
+  // (a scrambled order would give each block a random spread of points)
+  const size_t nb = r.stats.num_blocks;
+  std::vector<int32_t> block_comp(nb, -1);
+  std::vector<double> sum(3 * nb, 0.0), sum2(nb, 0.0);
+  std::vector<size_t> cnt(nb, 0);
+  for (size_t j = 0; j < n; ++j) {
+    const int32_t b = r.block[j];
+    ASSERT_GE(b, 0);
+    ASSERT_LT(static_cast<size_t>(b), nb);
+    if (block_comp[b] < 0)
+      block_comp[b] = r.component[j];
+    EXPECT_EQ(block_comp[b], r.component[j]) << "block " << b << " spans components";
+    cnt[b]++;
+    for (int a = 0; a < 3; ++a) {
+      sum[3 * b + a] += xyz[3 * j + a];
+      sum2[b] += double(xyz[3 * j + a]) * xyz[3 * j + a];
+    }
+  }
+  double within = 0.0;
+  for (size_t b = 0; b < nb; ++b) {
+    ASSERT_GT(cnt[b], 0u) << "block " << b << " is empty";
+    double m2 = 0.0;
+    for (int a = 0; a < 3; ++a)
+      m2 += sum[3 * b + a] * sum[3 * b + a] / double(cnt[b]);
+    within += sum2[b] - m2;
+  }
+  // Spread of the points about their box's centre (both boxes): blocks in a
+  // scrambled order would keep nearly all of it (ratio ~1); measured 0.53.
+  double box_spread = 0.0;
+  {
+    double s1[3] = {0, 0, 0}, s2 = 0.0;
+    for (size_t i = 0; i < half; ++i)
+      for (int a = 0; a < 3; ++a) {
+        s1[a] += sc.s.xyz[3 * i + a];
+        s2 += double(sc.s.xyz[3 * i + a]) * sc.s.xyz[3 * i + a];
+      }
+    box_spread = 2.0 * (s2 - (s1[0] * s1[0] + s1[1] * s1[1] + s1[2] * s1[2]) / double(half));
+  }
+  EXPECT_GE(nb, 4u);
+  EXPECT_LT(within, 0.75 * box_spread) << "blocks are not spatially compact";
+
+  // curvature: ~0 on the faces away from the creases, clearly > 0 on them
+  const double planes[5][2] = {{0, 0.0}, {0, 4.0}, {1, 0.0}, {1, 3.0}, {2, 0.0}};
+  double crease_sum = 0.0;
+  size_t crease_n = 0, flat_n = 0;
+  for (size_t j = 0; j < n; ++j) {
+    const float x[3] = {xyz[3 * j] - (xyz[3 * j] > 50.0f ? 100.0f : 0.0f), xyz[3 * j + 1],
+                        xyz[3 * j + 2]};
+    // distance to the second-closest of the five box planes
+    double d[5];
+    for (int k = 0; k < 5; ++k)
+      d[k] = std::fabs(x[static_cast<int>(planes[k][0])] - planes[k][1]);
+    std::sort(d, d + 5);
+    ASSERT_TRUE(std::isfinite(r.curvature[j])) << j;
+    if (d[1] > 0.4) {
+      EXPECT_LT(r.curvature[j], 1e-4f) << "flat point " << j;
+      ++flat_n;
+    }
+    else if (d[1] < 0.02) {
+      crease_sum += r.curvature[j];
+      ++crease_n;
+    }
+  }
+  ASSERT_GT(flat_n, n / 2);
+  ASSERT_GT(crease_n, 20u);
+  EXPECT_GT(crease_sum / double(crease_n), 0.02); // measured 0.083
+}
+
+TEST(DacpoPipeline, BlockFlipsAndEdgesAreConsistent)
+{
+  Scene sc;
+  generate(DACPO_SCENE_TWO_ROOMS, 20000, 3, &sc);
+  dacpo_params p = defaults();
+  p.ipsr_enabled = 0; // VCR weights still get one Poisson mesh per block
+  Result r = orientScene(sc, p);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  const dacpo_stats& st = r.stats;
+  ASSERT_GE(st.num_blocks, 4u);
+  ASSERT_EQ(r.flips.size(), st.num_blocks);
+  size_t flipped = 0;
+  for (uint8_t f : r.flips) {
+    EXPECT_LE(f, 1u);
+    flipped += f != 0;
+  }
+  EXPECT_EQ(st.flipped_blocks, flipped);
+
+  ASSERT_GE(st.num_block_edges, st.num_blocks - 1) << "one component needs a spanning graph";
+  ASSERT_EQ(r.edges.size(), st.num_block_edges);
+  std::set<std::pair<int32_t, int32_t>> pairs;
+  size_t zero = 0;
+  for (const dacpo_edge_info& e : r.edges) {
+    EXPECT_GE(e.block_a, 0);
+    EXPECT_LT(e.block_a, e.block_b);
+    EXPECT_LT(static_cast<size_t>(e.block_b), st.num_blocks);
+    EXPECT_TRUE(pairs.insert({e.block_a, e.block_b}).second) << "repeated edge";
+    EXPECT_TRUE(std::isfinite(e.alpha));
+    EXPECT_TRUE(std::isfinite(e.alpha_bar));
+    EXPECT_GE(e.alpha, 0.0);
+    EXPECT_GE(e.alpha_bar, 0.0);
+    EXPECT_GE(e.confidence, 0.0);
+    EXPECT_LE(e.confidence, 1.0);
+    zero += e.alpha == 0.0 && e.alpha_bar == 0.0;
+  }
+  EXPECT_EQ(st.zero_weight_edges, zero);
+  // block ids of the points index the flips array
+  for (int32_t b : r.block)
+    ASSERT_LT(static_cast<size_t>(b), r.flips.size());
+  EXPECT_EQ(st.input_points, sc.s.n);
+  EXPECT_EQ(st.unique_points + st.duplicate_points, st.input_points);
+  EXPECT_LE(st.largest_component, st.unique_points);
+  EXPECT_GT(st.peak_block_points, 0u);
+  EXPECT_EQ(st.ipsr_iterations_total, 0u);
+}
+
+TEST(DacpoPipeline, StageTimesAddUp)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  Result r = orientScene(sc, p);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  double sum = 0.0;
+  for (int s = 0; s < DACPO_STAGE_COUNT; ++s) {
+    EXPECT_GE(r.stats.stage_seconds[s], 0.0) << dacpo_stage_name(static_cast<dacpo_stage>(s));
+    sum += r.stats.stage_seconds[s];
+  }
+  EXPECT_GT(r.stats.total_seconds, 0.0);
+  EXPECT_LE(sum, r.stats.total_seconds + 1e-3);
+  // iPSR ran and its share of the stage 2-3 pass is reported
+  EXPECT_GT(r.stats.ipsr_iterations_total, 0u);
+  EXPECT_GE(r.stats.ipsr_iterations_total, r.stats.ipsr_iterations_max);
+  EXPECT_LE(r.stats.ipsr_iterations_max, p.ipsr_max_iterations);
+  EXPECT_GT(r.stats.stage_seconds[DACPO_STAGE_IPSR], 0.0);
+}
+
+// ---- determinism ----------------------------------------------------------------
+
+TEST(DacpoPipeline, SameSeedIsBitIdentical)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 4, &sc);
+  dacpo_params p = defaults();
+  p.seed = 42;
+  auto ctx = makeCtx();
+  // the second run reuses the context, the third gets a fresh one
+  Result a = orient(ctx.get(), p, sc.s.xyz, scrambled(sc, 9), sc.s.n);
+  Result b = orient(ctx.get(), p, sc.s.xyz, scrambled(sc, 9), sc.s.n);
+  Result c = orientScene(sc, p); // scrambled with another seed: same axes
+  ASSERT_EQ(a.status, DACPO_OK) << a.error;
+  ASSERT_EQ(b.status, DACPO_OK) << b.error;
+  ASSERT_EQ(c.status, DACPO_OK) << c.error;
+  EXPECT_TRUE(sameBits(a.normals, b.normals));
+  EXPECT_EQ(a.block, b.block);
+  EXPECT_EQ(a.flips, b.flips);
+  // The given signs are ignored: a different scramble gives the same result.
+  EXPECT_TRUE(sameBits(a.normals, c.normals));
+}
+
+TEST(DacpoPipeline, ThreadCountDoesNotChangeResult)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 5, &sc);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  p.num_threads = 1;
+  Result one = orientScene(sc, p);
+  p.num_threads = 2;
+  Result two = orientScene(sc, p);
+  ASSERT_EQ(one.status, DACPO_OK) << one.error;
+  ASSERT_EQ(two.status, DACPO_OK) << two.error;
+  EXPECT_TRUE(sameBits(one.normals, two.normals));
+  EXPECT_TRUE(sameBits(one.curvature, two.curvature));
+  EXPECT_EQ(one.block, two.block);
+  EXPECT_EQ(one.flips, two.flips);
+  ASSERT_EQ(one.edges.size(), two.edges.size());
+  for (size_t e = 0; e < one.edges.size(); ++e) {
+    EXPECT_EQ(one.edges[e].alpha, two.edges[e].alpha) << e;
+    EXPECT_EQ(one.edges[e].alpha_bar, two.edges[e].alpha_bar) << e;
+  }
+  EXPECT_EQ(one.stats.ipsr_iterations_total, two.stats.ipsr_iterations_total);
+}
+
+TEST(DacpoPipeline, CallerSearchMatchesBuiltIn)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 4000, 6, &sc);
+  BruteForce bf{sc.s.xyz, sc.s.n};
+  dacpo_search search = {bruteForceKnn, &bf};
+  for (int estimate : {0, 1}) {
+    SCOPED_TRACE(estimate ? "estimated normals" : "given normals");
+    dacpo_params p = defaults();
+    p.estimate_normals = estimate;
+    p.num_threads = 2; // the callback is reentrant
+    Result builtin = orientScene(sc, p);
+    Result caller = orientScene(sc, p, &search);
+    ASSERT_EQ(builtin.status, DACPO_OK) << builtin.error;
+    ASSERT_EQ(caller.status, DACPO_OK) << caller.error;
+    ASSERT_EQ(builtin.stats.duplicate_points, 0u);
+    EXPECT_TRUE(sameBits(builtin.normals, caller.normals));
+    EXPECT_EQ(builtin.block, caller.block);
+    EXPECT_EQ(builtin.flips, caller.flips);
+    EXPECT_TRUE(sameBits(builtin.curvature, caller.curvature));
+    EXPECT_LT(wrongPercent(sc, caller), 1.0);
+  }
+}
+
+// ---- options -------------------------------------------------------------------------
+
+// Measured: 0.000 % wrong for every combination below (10K points, given and
+// estimated normals).
+TEST(DacpoPipeline, EdgeWeightsAndIpsrAllSucceed)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  for (dacpo_edge_weight w :
+       {DACPO_WEIGHT_VCR, DACPO_WEIGHT_DIPOLE_BOUNDARY, DACPO_WEIGHT_OVERLAP}) {
+    for (int ipsr : {0, 1}) {
+      SCOPED_TRACE("edge_weight " + std::to_string(static_cast<int>(w)) + ", ipsr " +
+                   std::to_string(ipsr));
+      dacpo_params p = defaults();
+      p.edge_weight = w;
+      p.ipsr_enabled = ipsr;
+      Result r = orientScene(sc, p);
+      ASSERT_EQ(r.status, DACPO_OK) << r.error;
+      EXPECT_LT(wrongPercent(sc, r), 2.0);
+      EXPECT_EQ(r.stats.ipsr_iterations_total > 0, ipsr == 1);
+      EXPECT_EQ(r.edges.size(), r.stats.num_block_edges);
+    }
+  }
+}
+
+// ---- callbacks -----------------------------------------------------------------------
+
+TEST(DacpoPipeline, ProgressStagesAreOrdered)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  p.num_threads = 2;
+  ProgressLog log;
+  dacpo_progress prog = {logProgress, &log};
+  Result r = orientScene(sc, p, nullptr, &prog);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  ASSERT_GE(log.calls.size(), 2u);
+  EXPECT_EQ(log.off_thread, 0u) << "progress must arrive on the calling thread";
+  EXPECT_EQ(log.calls.front().first, DACPO_STAGE_INPUT);
+  EXPECT_EQ(log.calls.back().first, DACPO_STAGE_ILP);
+  EXPECT_EQ(log.calls.back().second, 1.0);
+  std::set<int> seen;
+  for (size_t i = 0; i < log.calls.size(); ++i) {
+    const int stage = log.calls[i].first;
+    const double f = log.calls[i].second;
+    EXPECT_GE(stage, 0);
+    EXPECT_LT(stage, DACPO_STAGE_COUNT);
+    EXPECT_GE(f, 0.0) << i;
+    EXPECT_LE(f, 1.0) << i;
+    if (i > 0) {
+      EXPECT_GE(stage, log.calls[i - 1].first) << "stage went back at call " << i;
+    }
+    seen.insert(stage);
+  }
+  for (int s : {DACPO_STAGE_NEIGHBORS, DACPO_STAGE_NORMALS, DACPO_STAGE_SEGMENT,
+                DACPO_STAGE_IPSR, DACPO_STAGE_EDGE_WEIGHTS})
+    EXPECT_EQ(seen.count(s), 1u) << dacpo_stage_name(static_cast<dacpo_stage>(s));
+}
+
+// ---- output form ------------------------------------------------------------------------
+
+TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 10000, 7, &sc);
+  const size_t n = sc.s.n;
+  // Given axes: ground truth tilted a little, any length, random sign. The
+  // output must be the given axis, normalized, only its sign chosen.
+  std::vector<float> given = scrambled(sc, 11);
+  uint64_t st = 99;
+  for (size_t i = 0; i < n; ++i) {
+    st = st * 6364136223846793005ull + 1442695040888963407ull;
+    const float scale = 0.01f + 10.0f * static_cast<float>((st >> 40) & 0xFFFF) / 65536.0f;
+    const float tilt = 0.2f * (static_cast<float>((st >> 20) & 0xFFFF) / 65536.0f - 0.5f);
+    given[3 * i] = scale * (given[3 * i] + tilt);
+    given[3 * i + 1] = scale * (given[3 * i + 1] - tilt);
+    given[3 * i + 2] = scale * (given[3 * i + 2] + 0.5f * tilt);
+  }
+  auto ctx = makeCtx();
+  Result r = orient(ctx.get(), defaults(), sc.s.xyz, given, n);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  size_t bad_len = 0, bad_axis = 0;
+  for (size_t i = 0; i < n; ++i) {
+    double g[3], len2 = 0.0, glen = 0.0, dot = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      g[a] = given[3 * i + a];
+      glen += g[a] * g[a];
+    }
+    glen = std::sqrt(glen);
+    for (int a = 0; a < 3; ++a) {
+      const double o = r.normals[3 * i + a];
+      len2 += o * o;
+      dot += o * g[a] / glen;
+    }
+    bad_len += std::fabs(std::sqrt(len2) - 1.0) > 1e-6;
+    bad_axis += std::fabs(std::fabs(dot) - 1.0) > 1e-6;
+  }
+  EXPECT_EQ(bad_len, 0u);
+  EXPECT_EQ(bad_axis, 0u);
+  // tilted axes do not change which way they point
+  EXPECT_LT(wrongPercent(sc, r), 1.0);
+}
