@@ -69,7 +69,6 @@ dacpo_params_init(dacpo_params* p)
   p->seed = 1;
   p->num_threads = 0;
   p->disconnected = DACPO_DISCONNECTED_SEPARATE;
-  p->min_component_size = 1;
   p->dipole_noise_band = 0.0;
 }
 

@@ -483,7 +483,8 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   d.setSolverTimeLimit(2.5);
   d.setSeed(99);
   d.setNumberOfThreads(3);
-  d.setMinComponentSize(5);
+  d.setDipoleNoiseBand(2.5);
+  d.setDisconnectedPolicy(DACPO_DISCONNECTED_BRIDGE);
   EXPECT_EQ(d.getNormalK(), 12u);
   EXPECT_EQ(d.getNumberOfBlocks(), 7u);
   EXPECT_EQ(d.getRingHops(), 2u);
@@ -496,7 +497,8 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_EQ(d.getSolverTimeLimit(), 2.5);
   EXPECT_EQ(d.getSeed(), 99u);
   EXPECT_EQ(d.getNumberOfThreads(), 3u);
-  EXPECT_EQ(d.getMinComponentSize(), 5u);
+  EXPECT_EQ(d.getDipoleNoiseBand(), 2.5);
+  EXPECT_EQ(d.getDisconnectedPolicy(), DACPO_DISCONNECTED_BRIDGE);
   const dacpo_params p = d.getParameters();
   EXPECT_EQ(p.k, 10u);
   EXPECT_EQ(p.estimate_normals, 1);

@@ -134,8 +134,6 @@ typedef struct dacpo_params {
   uint64_t seed;            /**< all randomness derives from it (1) */
   unsigned num_threads;     /**< 0 = all cores (0) */
   dacpo_disconnected_policy disconnected; /**< (SEPARATE) */
-  size_t min_component_size; /**< components smaller than this are oriented
-                                  as one block without segmentation (1) */
   double dipole_noise_band; /**< pairs whose offsets along both normals are
                                  below this many times the block's noise scale
                                  (median RMS offset of neighbours from the

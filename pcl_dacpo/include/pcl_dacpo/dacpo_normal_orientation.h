@@ -327,18 +327,6 @@ public:
     return params_.disconnected;
   }
 
-  /** \brief Components smaller than this are oriented as one block (default 1). */
-  void
-  setMinComponentSize(std::size_t size)
-  {
-    params_.min_component_size = size;
-  }
-  /** \brief See setMinComponentSize(). */
-  std::size_t
-  getMinComponentSize() const
-  {
-    return params_.min_component_size;
-  }
 
   /** \brief Noise band of the dipole field (0 = off, default): neighbour pairs whose
    * offsets along both normals are below this many times the block's noise scale
