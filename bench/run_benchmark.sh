@@ -731,6 +731,24 @@ def meta_markdown(meta):
 
 
 # ---------------------------------------------------------------- main
+def portable(obj):
+    """Results name paths relative to <work>, <build>, <data> and <repo>, so the
+    committed JSON carries no machine's absolute paths."""
+    prefixes = [(os.path.abspath(work), "<work>"), (os.path.abspath(build), "<build>"),
+                (os.path.abspath(opt["data"]), "<data>") if opt.get("data") else None,
+                (os.path.abspath(ROOT), "<repo>")]
+    prefixes = [p for p in prefixes if p]
+    if isinstance(obj, dict):
+        return {k: portable(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [portable(v) for v in obj]
+    if isinstance(obj, str):
+        for path, name in prefixes:
+            obj = obj.replace(path, name)
+        return obj
+    return obj
+
+
 def main():
     if what != "report":
         ensure_tools()
@@ -755,7 +773,7 @@ def main():
             except OSError:
                 pass
     with open(rj + ".tmp", "w") as f:
-        json.dump(allres, f, indent=1)
+        json.dump(portable(allres), f, indent=1)
     os.replace(rj + ".tmp", rj)
     md = ["# pcl_dacpo benchmark results\n",
           "Written by `bench/run_benchmark.sh` (see bench/README.md); raw records in results.json.\n"]
