@@ -165,6 +165,12 @@ dacpo_ctx_clear_results(dacpo_ctx* ctx)
   free(ctx->point_curvature);
   free(ctx->block_flips);
   free(ctx->edges);
+  free(ctx->mesh_vertices);
+  free(ctx->mesh_triangles);
+  ctx->mesh_vertices = NULL;
+  ctx->mesh_triangles = NULL;
+  ctx->mesh_num_vertices = 0;
+  ctx->mesh_num_triangles = 0;
   ctx->point_component = NULL;
   ctx->point_block = NULL;
   ctx->point_curvature = NULL;
@@ -217,6 +223,21 @@ const float*
 dacpo_ctx_point_curvature(const dacpo_ctx* ctx)
 {
   return ctx ? ctx->point_curvature : NULL;
+}
+
+size_t
+dacpo_ctx_mesh(const dacpo_ctx* ctx,
+               const float** vertices,
+               size_t* num_vertices,
+               const int32_t** triangles)
+{
+  if (vertices)
+    *vertices = ctx ? ctx->mesh_vertices : NULL;
+  if (num_vertices)
+    *num_vertices = ctx ? ctx->mesh_num_vertices : 0;
+  if (triangles)
+    *triangles = ctx ? ctx->mesh_triangles : NULL;
+  return ctx ? ctx->mesh_num_triangles : 0;
 }
 
 const uint8_t*

@@ -13,6 +13,10 @@ struct dacpo_ctx {
   float* point_curvature;   /* input_points, only when normals were estimated */
   uint8_t* block_flips;     /* num_blocks */
   dacpo_edge_info* edges;   /* num_block_edges */
+  float* mesh_vertices;     /* 3 * mesh_num_vertices (keep_mesh) */
+  int32_t* mesh_triangles;  /* 3 * mesh_num_triangles */
+  size_t mesh_num_vertices;
+  size_t mesh_num_triangles;
 };
 
 /* Frees the per-run results and zeroes the stats. */

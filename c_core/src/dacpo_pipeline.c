@@ -263,6 +263,43 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 /* ---- results ----------------------------------------------------------- */
 
+/* One scene mesh from the block meshes; a flipped block's triangles are
+ * re-wound so face normals follow the output normals. */
+static dacpo_status
+publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
+{
+  size_t nv = 0, nt = 0;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    nv += s->meshes[b].num_vertices;
+    nt += s->meshes[b].num_triangles;
+  }
+  DACPO_CHECK(err, nv < (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
+              "scene mesh has %zu vertices, more than int32 indices hold", nv);
+  ctx->mesh_vertices = dacpo_malloc_array(3 * nv, sizeof(float));
+  ctx->mesh_triangles = dacpo_malloc_array(3 * nt, sizeof(int32_t));
+  if (!ctx->mesh_vertices || !ctx->mesh_triangles)
+    return DACPO_OOM(err);
+  size_t v0 = 0, t0 = 0;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    const dacpo_mesh* m = &s->meshes[b];
+    for (size_t i = 0; i < 3 * m->num_vertices; ++i)
+      ctx->mesh_vertices[3 * v0 + i] = (float)m->vertices[i];
+    const int flip = s->flips[b] != 0;
+    for (size_t t = 0; t < m->num_triangles; ++t) {
+      int32_t* out = ctx->mesh_triangles + 3 * (t0 + t);
+      const int32_t* in = m->triangles + 3 * t;
+      out[0] = in[0] + (int32_t)v0;
+      out[1] = in[flip ? 2 : 1] + (int32_t)v0;
+      out[2] = in[flip ? 1 : 2] + (int32_t)v0;
+    }
+    v0 += m->num_vertices;
+    t0 += m->num_triangles;
+  }
+  ctx->mesh_num_vertices = nv;
+  ctx->mesh_num_triangles = nt;
+  return DACPO_OK;
+}
+
 static dacpo_status
 publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 {
@@ -319,6 +356,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
+  if (s->p.keep_mesh && s->meshes)
+    DACPO_TRY(publish_mesh(ctx, s, err));
   st->solver_optimal = s->ilp.optimal;
   st->solver_objective = s->ilp.objective;
   st->ilp_constraints = s->ilp.constraints;
@@ -394,7 +433,7 @@ run(dacpo_ctx* ctx,
   s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
   s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
   s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
-  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR;
+  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
   if (want_meshes)
     s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
   const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;

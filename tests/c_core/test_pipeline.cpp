@@ -603,3 +603,61 @@ TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
   // tilted axes do not change which way they point
   EXPECT_LT(wrongPercent(sc, r), 1.0);
 }
+
+// keep_mesh: the blocks' trimmed iPSR meshes come back as one mesh whose faces are
+// wound like the output normals (flipped blocks re-wound), near the samples.
+TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 8000, 3, &sc);
+  dacpo_params p = defaults();
+  p.keep_mesh = 1;
+  auto ctx = makeCtx();
+  Result r = orient(ctx.get(), p, sc.s.xyz, scrambled(sc, 7), sc.s.n);
+  ASSERT_EQ(r.status, DACPO_OK) << r.error;
+  ASSERT_GT(r.stats.flipped_blocks, 0u) << "the test should cover re-wound blocks";
+  const float* v = nullptr;
+  const int32_t* t = nullptr;
+  size_t nv = 0;
+  const size_t nt = dacpo_ctx_mesh(ctx.get(), &v, &nv, &t);
+  ASSERT_GT(nt, 1000u);
+  ASSERT_GT(nv, 500u);
+  // Every 37th face: its normal against the output normal of the nearest sample.
+  size_t agree = 0, checked = 0;
+  for (size_t f = 0; f < nt; f += 37, ++checked) {
+    const float* a = v + 3 * t[3 * f];
+    const float* b = v + 3 * t[3 * f + 1];
+    const float* c = v + 3 * t[3 * f + 2];
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GE(t[3 * f + k], 0);
+      ASSERT_LT(static_cast<size_t>(t[3 * f + k]), nv);
+    }
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                          e1[0] * e2[1] - e1[1] * e2[0]};
+    const double m[3] = {(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3,
+                         (a[2] + b[2] + c[2]) / 3};
+    size_t best = 0;
+    double bestd = 1e300;
+    for (size_t i = 0; i < sc.s.n; ++i) {
+      const float* q = sc.s.xyz + 3 * i;
+      const double d = (q[0] - m[0]) * (q[0] - m[0]) + (q[1] - m[1]) * (q[1] - m[1]) +
+                       (q[2] - m[2]) * (q[2] - m[2]);
+      if (d < bestd) {
+        bestd = d;
+        best = i;
+      }
+    }
+    const float* on = r.normals.data() + 3 * best;
+    agree += fn[0] * on[0] + fn[1] * on[1] + fn[2] * on[2] > 0.0;
+  }
+  RecordProperty("agreeing_faces", std::to_string(agree) + "/" + std::to_string(checked));
+  EXPECT_GT(static_cast<double>(agree), 0.95 * static_cast<double>(checked));
+
+  // Without keep_mesh there is no mesh.
+  dacpo_params q = defaults();
+  Result r2 = orient(ctx.get(), q, sc.s.xyz, scrambled(sc, 7), sc.s.n);
+  ASSERT_EQ(r2.status, DACPO_OK);
+  EXPECT_EQ(dacpo_ctx_mesh(ctx.get(), nullptr, nullptr, nullptr), 0u);
+}

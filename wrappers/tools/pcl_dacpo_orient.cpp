@@ -16,6 +16,7 @@
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <pcl/point_types.h>
+#include <pcl/PolygonMesh.h>
 
 #include "dacpo_tool_io.h"
 #include <sys/resource.h>
@@ -71,6 +72,7 @@ struct Options {
   bool labels = false;        /* -labels: block, component, flip fields */
   std::string edges;          /* -edges file.csv */
   std::string blocks_colored; /* -blocks_colored file.{pcd,ply} */
+  std::string mesh;           /* -mesh file.ply */
 };
 
 /* What a run leaves for the diagnostics, in output (= input) point order. */
@@ -80,6 +82,8 @@ struct Result {
   std::vector<int> blocks, components;
   std::vector<std::uint8_t> flips;
   std::vector<dacpo_edge_info> edges;
+  std::vector<float> mesh_vertices;
+  std::vector<std::int32_t> mesh_triangles;
 };
 
 /* Output fields written by -labels; dropped from the input in any case, since
@@ -118,6 +122,14 @@ printHelp(int, char** argv)
              "                                   1.2-1.5 depth frames (default: ");
   print_value("%g", d.dipole_c);
   print_info(")\n");
+  print_info("                     -mesh F.ply = also write the reconstructed surface "
+             "(trimmed iPSR\n"
+             "                                   block meshes, wound like the output "
+             "normals)\n");
+  print_info("                     -mesh F.ply = also write the reconstructed surface "
+             "(trimmed iPSR\n"
+             "                                   block meshes, wound like the output "
+             "normals)\n");
   print_info("                     -bridge     = join disconnected parts along their "
              "minimum spanning tree\n"
              "                                   and orient them as one (default: each "
@@ -358,6 +370,8 @@ compute(const pcl::PCLPointCloud2& input,
   result.components = dacpo.getComponentLabels();
   result.flips = dacpo.getBlockFlips();
   result.edges = dacpo.getEdges();
+  result.mesh_vertices = dacpo.getMeshVertices();
+  result.mesh_triangles = dacpo.getMeshTriangles();
 
   /* Keep every input field except the ones we write, then append ours. */
   pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(
@@ -551,6 +565,37 @@ peakRssMb()
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
+/* The reconstructed surface (-mesh): the blocks' trimmed iPSR meshes, wound like
+ * the output normals, as binary PLY (vertex x y z, face vertex_indices). */
+bool
+saveMesh(const std::string& filename, const Result& r)
+{
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  vertices.resize(r.mesh_vertices.size() / 3);
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    vertices[i].getVector3fMap() << r.mesh_vertices[3 * i], r.mesh_vertices[3 * i + 1],
+        r.mesh_vertices[3 * i + 2];
+  pcl::PolygonMesh mesh;
+  pcl::toPCLPointCloud2(vertices, mesh.cloud);
+  mesh.polygons.resize(r.mesh_triangles.size() / 3);
+  for (std::size_t t = 0; t < mesh.polygons.size(); ++t)
+    mesh.polygons[t].vertices = {static_cast<pcl::index_t>(r.mesh_triangles[3 * t]),
+                                 static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 1]),
+                                 static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 2])};
+  if (pcl::io::savePLYFileBinary(filename, mesh) < 0) {
+    print_error("Error: cannot write the mesh to '%s'\n", filename.c_str());
+    return false;
+  }
+  info("Saved mesh ");
+  value("%s", filename.c_str());
+  info(": ");
+  value("%zu", vertices.size());
+  info(" vertices, ");
+  value("%zu", mesh.polygons.size());
+  info(" triangles\n");
+  return true;
+}
+
 bool
 parseOptions(int argc, char** argv, Options& o)
 {
@@ -610,7 +655,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.estimate = find_switch(argc, argv, "-estimate");
   o.quiet = find_switch(argc, argv, "-q");
   o.labels = find_switch(argc, argv, "-labels");
-  for (const char* name : {"-edges", "-blocks_colored"}) {
+  for (const char* name : {"-edges", "-blocks_colored", "-mesh"}) {
     const int at = find_argument(argc, argv, name);
     if (at < 0)
       continue;
@@ -618,7 +663,21 @@ parseOptions(int argc, char** argv, Options& o)
       print_error("Error: %s needs a file name\n", name);
       return false;
     }
-    (std::strcmp(name, "-edges") == 0 ? o.edges : o.blocks_colored) = argv[at + 1];
+    std::string& target = std::strcmp(name, "-edges") == 0
+                              ? o.edges
+                              : (std::strcmp(name, "-mesh") == 0 ? o.mesh : o.blocks_colored);
+    target = argv[at + 1];
+  }
+  if (!o.mesh.empty()) {
+    if (dacpo_tool::extension(o.mesh) != ".ply") {
+      print_error("Error: -mesh needs a .ply file name, got '%s'\n", o.mesh.c_str());
+      return false;
+    }
+    if (!o.params.ipsr_enabled) {
+      print_error("Error: -mesh needs the iPSR stage (drop -no_ipsr)\n");
+      return false;
+    }
+    o.params.keep_mesh = 1;
   }
   if (!o.blocks_colored.empty()) {
     const std::string ext = dacpo_tool::extension(o.blocks_colored);
@@ -651,7 +710,7 @@ main(int argc, char** argv)
     return argc < 3 ? 1 : 0;
   }
   const std::vector<std::string> files =
-      dacpo_tool::fileArguments(argc, argv, {"-edges", "-blocks_colored"});
+      dacpo_tool::fileArguments(argc, argv, {"-edges", "-blocks_colored", "-mesh"});
   if (files.size() != 2) {
     print_error("Need one input and one output file (.pcd or .ply), got %zu.\n",
                 files.size());
@@ -683,6 +742,8 @@ main(int argc, char** argv)
     return 1;
   if (!options.blocks_colored.empty() &&
       !saveBlocksColored(options.blocks_colored, cloud, result))
+    return 1;
+  if (!options.mesh.empty() && !saveMesh(options.mesh, result))
     return 1;
 
   /* One machine-readable line, printed even with -q (benchmarks grep it). */

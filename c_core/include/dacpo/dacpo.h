@@ -141,6 +141,9 @@ typedef struct dacpo_params {
                                  Eq. 1; 0 = off, the paper's field (0). With
                                  c = 4 a band of 3 cut the error on a room
                                  with noise 0.008 from 46 % to 10 %. */
+  int keep_mesh; /**< 1: keep the trimmed stage-3 block meshes, wound to agree
+                      with the final (flipped) normals, as one scene mesh; see
+                      dacpo_ctx_mesh() (0) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -259,6 +262,22 @@ DACPO_API const int32_t*
 dacpo_ctx_point_blocks(const dacpo_ctx* ctx);
 DACPO_API const float*
 dacpo_ctx_point_curvature(const dacpo_ctx* ctx);
+
+/**
+ * \brief Scene mesh of the last successful run with params.keep_mesh = 1: the
+ * trimmed iPSR meshes of all blocks (own points only), each block's winding
+ * reversed when the block was flipped, so face normals agree with the output
+ * normals. Blocks are not stitched together. Arrays are owned by the context.
+ * \param[out] vertices     3 floats per vertex (may be NULL)
+ * \param[out] num_vertices (may be NULL)
+ * \param[out] triangles    3 vertex indices per triangle (may be NULL)
+ * \return the number of triangles (0 without a mesh).
+ */
+DACPO_API size_t
+dacpo_ctx_mesh(const dacpo_ctx* ctx,
+               const float** vertices,
+               size_t* num_vertices,
+               const int32_t** triangles);
 
 /** \brief Per-block flip decided by the 0-1 program (num_blocks entries), or NULL. */
 DACPO_API const uint8_t*

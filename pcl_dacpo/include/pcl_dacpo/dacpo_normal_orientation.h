@@ -328,6 +328,20 @@ public:
   }
 
 
+  /** \brief Keep the reconstructed surface: the trimmed iPSR block meshes, wound to
+   * agree with the output normals (default false); see getMeshVertices(). */
+  void
+  setKeepMesh(bool keep)
+  {
+    params_.keep_mesh = keep ? 1 : 0;
+  }
+  /** \brief See setKeepMesh(). */
+  bool
+  getKeepMesh() const
+  {
+    return params_.keep_mesh != 0;
+  }
+
   /** \brief Noise band of the dipole field (0 = off, default): neighbour pairs whose
    * offsets along both normals are below this many times the block's noise scale
    * count as coplanar. */
@@ -423,6 +437,21 @@ public:
     return edges_;
   }
 
+  /** \brief Scene mesh of the last compute() with setKeepMesh(true): x, y, z per
+   * vertex (same frame as the input). Empty otherwise. */
+  const std::vector<float>&
+  getMeshVertices() const
+  {
+    return mesh_vertices_;
+  }
+
+  /** \brief Scene mesh triangles: three indices into getMeshVertices() each. */
+  const std::vector<std::int32_t>&
+  getMeshTriangles() const
+  {
+    return mesh_triangles_;
+  }
+
 protected:
   using Feature<PointInT, PointOutT>::feature_name_;
   using Feature<PointInT, PointOutT>::getClassName;
@@ -478,6 +507,8 @@ private:
   std::vector<int> block_labels_;
   std::vector<std::uint8_t> block_flips_;
   std::vector<dacpo_edge_info> edges_;
+  std::vector<float> mesh_vertices_;
+  std::vector<std::int32_t> mesh_triangles_;
 };
 
 } // namespace pcl

@@ -209,6 +209,8 @@ DACPONormalOrientation<PointInT, PointOutT>::fail(PointCloudOut& output,
   block_labels_.clear();
   block_flips_.clear();
   edges_.clear();
+  mesh_vertices_.clear();
+  mesh_triangles_.clear();
 }
 
 template <typename PointInT, typename PointOutT>
@@ -223,6 +225,8 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   block_labels_.clear();
   block_flips_.clear();
   edges_.clear();
+  mesh_vertices_.clear();
+  mesh_triangles_.clear();
 
   if (k_ <= 0 || search_radius_ != 0.0) {
     fail(output,
@@ -384,6 +388,16 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
     block_flips_.assign(flips, flips + stats_.num_blocks);
   if (const dacpo_edge_info* edges = dacpo_ctx_edges(ctx.get()))
     edges_.assign(edges, edges + stats_.num_block_edges);
+  {
+    const float* mv = nullptr;
+    const std::int32_t* mt = nullptr;
+    std::size_t nv = 0;
+    const std::size_t nt = dacpo_ctx_mesh(ctx.get(), &mv, &nv, &mt);
+    if (nt > 0) {
+      mesh_vertices_.assign(mv, mv + 3 * nv);
+      mesh_triangles_.assign(mt, mt + 3 * nt);
+    }
+  }
 
   if (stats_.num_components > 1 && stats_.bridges_added > 0)
     PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
