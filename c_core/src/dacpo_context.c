@@ -70,6 +70,11 @@ dacpo_params_init(dacpo_params* p)
   p->num_threads = 0;
   p->disconnected = DACPO_DISCONNECTED_SEPARATE;
   p->dipole_noise_band = 0.0;
+  p->keep_mesh = 0;
+  p->vcr_image_size = 400;
+  p->vcr_views = 12;
+  p->vcr_perspective = 0;
+  p->vcr_boundary_factor = 1;
 }
 
 static dacpo_status
@@ -125,6 +130,11 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (!(p->dipole_noise_band >= 0.0) || !isfinite(p->dipole_noise_band))
     return bad_field(message, size, "dipole_noise_band must be finite and >= 0 (got %g)",
                      p->dipole_noise_band);
+  if (p->vcr_image_size < 16 || p->vcr_image_size > 4096)
+    return bad_field(message, size, "vcr_image_size must be in [16, 4096] (got %zu)",
+                     p->vcr_image_size);
+  if (p->vcr_views < 1 || p->vcr_views > 256)
+    return bad_field(message, size, "vcr_views must be in [1, 256] (got %zu)", p->vcr_views);
   if (p->num_threads > 1024)
     return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
   if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&

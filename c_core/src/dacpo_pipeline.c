@@ -230,6 +230,10 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
   dacpo_block_edge* edge = &s->bgraph.edges[e];
   dacpo_vcr_params vp;
   dacpo_vcr_params_default(&vp);
+  vp.image_size = s->p.vcr_image_size;
+  vp.num_views = s->p.vcr_views;
+  vp.perspective = s->p.vcr_perspective != 0;
+  vp.boundary_factor = s->p.vcr_boundary_factor != 0;
   (void)thread_id;
   return dacpo_vcr_edge(&s->meshes[edge->a], &s->meshes[edge->b], &vp, &edge->alpha,
                         &edge->alpha_bar, err);

@@ -122,6 +122,16 @@ printHelp(int, char** argv)
              "                                   1.2-1.5 depth frames (default: ");
   print_value("%g", d.dipole_c);
   print_info(")\n");
+  print_info("                     -vcr_size X = VCR image side in pixels (default: ");
+  print_value("%zu", d.vcr_image_size);
+  print_info(")\n");
+  print_info("                     -vcr_views X = VCR views (default: ");
+  print_value("%zu", d.vcr_views);
+  print_info(")\n");
+  print_info("                     -vcr_perspective = perspective VCR projection "
+             "(default: orthographic)\n");
+  print_info("                     -vcr_c1c2   = VCR score C1*C2 without the boundary "
+             "factor C_B\n");
   print_info("                     -mesh F.ply = also write the reconstructed surface "
              "(trimmed iPSR\n"
              "                                   block meshes, wound like the output "
@@ -601,13 +611,16 @@ parseOptions(int argc, char** argv, Options& o)
 {
   dacpo_params_init(&o.params);
   std::string error;
+  std::uint64_t vcr_size = o.params.vcr_image_size, vcr_views = o.params.vcr_views;
   std::uint64_t k = o.params.k, normal_k = o.params.normal_k,
                 blocks = o.params.num_blocks, orders = o.params.dipole_orders,
                 ring = o.params.ring_hops, seed = o.params.seed,
                 threads = o.params.num_threads;
   double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
          band = o.params.dipole_noise_band;
-  if (!dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
+  if (!dacpo_tool::parseUnsigned(argc, argv, "-vcr_size", vcr_size, error) ||
+      !dacpo_tool::parseUnsigned(argc, argv, "-vcr_views", vcr_views, error) ||
+      !dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-normal_k", normal_k, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-blocks", blocks, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-orders", orders, error) ||
@@ -634,6 +647,12 @@ parseOptions(int argc, char** argv, Options& o)
   o.params.num_threads = static_cast<unsigned>(threads);
   o.params.dipole_c = c;
   o.params.dipole_noise_band = band;
+  o.params.vcr_image_size = vcr_size;
+  o.params.vcr_views = vcr_views;
+  if (find_switch(argc, argv, "-vcr_perspective"))
+    o.params.vcr_perspective = 1;
+  if (find_switch(argc, argv, "-vcr_c1c2"))
+    o.params.vcr_boundary_factor = 0;
   o.params.solver_time_limit = time_limit;
   o.params.ipsr_enabled = find_switch(argc, argv, "-no_ipsr") ? 0 : 1;
   std::string weights;

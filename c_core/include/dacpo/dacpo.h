@@ -144,6 +144,11 @@ typedef struct dacpo_params {
   int keep_mesh; /**< 1: keep the trimmed stage-3 block meshes, wound to agree
                       with the final (flipped) normals, as one scene mesh; see
                       dacpo_ctx_mesh() (0) */
+  size_t vcr_image_size;  /**< VCR image side in pixels, in [16, 4096] (400, paper) */
+  size_t vcr_views;       /**< VCR views: 12 = dodecahedron face centres (paper);
+                               other counts use a Fibonacci sphere, [1, 256] (12) */
+  int vcr_perspective;    /**< 1: perspective projection (paper); 0: orthographic (0) */
+  int vcr_boundary_factor; /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -328,6 +328,58 @@ public:
   }
 
 
+  /** \brief VCR image side in pixels (default 400, as in the paper). */
+  void
+  setVCRImageSize(std::size_t pixels)
+  {
+    params_.vcr_image_size = pixels;
+  }
+  /** \brief See setVCRImageSize(). */
+  std::size_t
+  getVCRImageSize() const
+  {
+    return params_.vcr_image_size;
+  }
+
+  /** \brief Number of VCR views (default 12: the dodecahedron face centres). */
+  void
+  setVCRViews(std::size_t views)
+  {
+    params_.vcr_views = views;
+  }
+  /** \brief See setVCRViews(). */
+  std::size_t
+  getVCRViews() const
+  {
+    return params_.vcr_views;
+  }
+
+  /** \brief Perspective (true) or orthographic (false, default) VCR projection. */
+  void
+  setVCRPerspective(bool perspective)
+  {
+    params_.vcr_perspective = perspective ? 1 : 0;
+  }
+  /** \brief See setVCRPerspective(). */
+  bool
+  getVCRPerspective() const
+  {
+    return params_.vcr_perspective != 0;
+  }
+
+  /** \brief VCR score I = C_B*C1*C2 (true, default, paper) or C1*C2 (false). */
+  void
+  setVCRBoundaryFactor(bool use)
+  {
+    params_.vcr_boundary_factor = use ? 1 : 0;
+  }
+  /** \brief See setVCRBoundaryFactor(). */
+  bool
+  getVCRBoundaryFactor() const
+  {
+    return params_.vcr_boundary_factor != 0;
+  }
+
   /** \brief Keep the reconstructed surface: the trimmed iPSR block meshes, wound to
    * agree with the output normals (default false); see getMeshVertices(). */
   void
