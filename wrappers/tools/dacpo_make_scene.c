@@ -51,21 +51,6 @@ print_help(const char* prog)
 
 /* Strict parsers: the whole argument must be a number in range. */
 static int
-parse_size(const char* s, size_t* out)
-{
-  char* end;
-  unsigned long long v;
-  if (!s || *s < '0' || *s > '9')
-    return -1;
-  errno = 0;
-  v = strtoull(s, &end, 10);
-  if (errno != 0 || *end != '\0' || v > (unsigned long long)SIZE_MAX)
-    return -1;
-  *out = (size_t)v;
-  return 0;
-}
-
-static int
 parse_u64(const char* s, uint64_t* out)
 {
   char* end;
@@ -77,6 +62,16 @@ parse_u64(const char* s, uint64_t* out)
   if (errno != 0 || *end != '\0')
     return -1;
   *out = (uint64_t)u;
+  return 0;
+}
+
+static int
+parse_size(const char* s, size_t* out)
+{
+  uint64_t v;
+  if (parse_u64(s, &v) != 0 || v > (uint64_t)SIZE_MAX)
+    return -1;
+  *out = (size_t)v;
   return 0;
 }
 
