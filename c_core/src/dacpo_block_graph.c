@@ -26,6 +26,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+static int
+compare_double(const void* a, const void* b)
+{
+  const double x = *(const double*)a, y = *(const double*)b;
+  return x < y ? -1 : x > y;
+}
+
 static uint64_t
 pair_key(int32_t a, int32_t b)
 {
@@ -212,15 +219,47 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
 }
 
 void
-dacpo_edge_omega(double alpha, double alpha_bar, double* w_same, double* w_diff)
+dacpo_edge_omega(double alpha, double alpha_bar, double scale, double* w_same, double* w_diff)
 {
-  /* Eq. 7; eps keeps an edge without evidence at (0, 0) instead of NaN. */
-  const double eps = 1e-12;
-  const double den = alpha + alpha_bar + eps;
+  /* Eq. 7 gives every edge the same total weight, so a contact of a few pixels
+   * or pairs outvotes a long shared wall around a cycle. The ratio is kept as
+   * the edge's confidence, and the total is scaled by g = a / (1 + a), a = the
+   * edge's evidence relative to a typical edge: about 1 for ordinary and strong
+   * edges, proportional to the evidence for weak ones. No evidence, or evidence
+   * that is not finite, gives (0, 0). */
+  const double den = alpha + alpha_bar;
+  double ws = 0.0, wd = 0.0;
+  if (den > 0.0 && isfinite(den)) {
+    const double amount = scale > 0.0 ? den / scale : HUGE_VAL;
+    const double g = isinf(amount) ? 1.0 : amount / (1.0 + amount);
+    ws = g * (alpha / den);
+    wd = g * (alpha_bar / den);
+  }
   if (w_same)
-    *w_same = alpha / den;
+    *w_same = ws;
   if (w_diff)
-    *w_diff = alpha_bar / den;
+    *w_diff = wd;
+}
+
+double
+dacpo_edge_evidence_scale(const dacpo_block_graph* g)
+{
+  /* median of alpha + alpha_bar over the edges that carry evidence */
+  size_t m = 0;
+  double* v = g && g->num_edges ? dacpo_malloc_array(g->num_edges, sizeof(double)) : NULL;
+  if (!v)
+    return 0.0;
+  for (size_t e = 0; e < g->num_edges; ++e) {
+    const double t = g->edges[e].alpha + g->edges[e].alpha_bar;
+    if (t > 0.0 && isfinite(t))
+      v[m++] = t;
+  }
+  /* insertion into a sorted prefix would be O(m^2); m is the edge count
+   * (hundreds to a few thousand), so a plain qsort is enough */
+  qsort(v, m, sizeof(double), compare_double);
+  const double med = m ? (m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2])) : 0.0;
+  free(v);
+  return med;
 }
 
 dacpo_status

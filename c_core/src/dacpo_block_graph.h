@@ -59,8 +59,16 @@ dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
                                   const double* ring_nrm,
                                   dacpo_err* err);
 
-/* Paper Eq. 7: w_same = alpha/(alpha+alpha_bar+eps), w_diff = alpha_bar/(...). */
+/* Paper Eq. 7 with the amount of evidence kept: w_same = g alpha/(alpha +
+ * alpha_bar), w_diff = g alpha_bar/(alpha + alpha_bar), g = a/(1+a) with
+ * a = (alpha + alpha_bar)/scale; scale <= 0 gives g = 1 (Eq. 7 as printed).
+ * (0, 0) without evidence. NULL outputs are skipped. */
 void
-dacpo_edge_omega(double alpha, double alpha_bar, double* w_same, double* w_diff);
+dacpo_edge_omega(double alpha, double alpha_bar, double scale, double* w_same, double* w_diff);
+
+/* The typical evidence of an edge: the median of alpha + alpha_bar over the
+ * edges that have any (0 when none has, or on allocation failure). */
+double
+dacpo_edge_evidence_scale(const dacpo_block_graph* g);
 
 #endif

@@ -61,20 +61,21 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_c = 1.5;
   p->dipole_orders = 5;
   p->dipole_neighbors = 32;
-  p->dipole_final_sweep = 1;
+  p->dipole_final_sweep = 10;
   p->ipsr_enabled = 1;
   p->ipsr_max_iterations = 20;
   p->edge_weight = DACPO_WEIGHT_VCR;
   p->solver_time_limit = 30.0;
   p->seed = 1;
   p->num_threads = 0;
-  p->disconnected = DACPO_DISCONNECTED_SEPARATE;
+  p->disconnected = DACPO_DISCONNECTED_VIEWPOINT;
   p->dipole_noise_band = 0.0;
   p->keep_mesh = 0;
   p->vcr_image_size = 400;
   p->vcr_views = 12;
   p->vcr_perspective = 0;
   p->vcr_boundary_factor = 1;
+  p->dipole_restarts = 4;
 }
 
 static dacpo_status
@@ -118,6 +119,12 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (p->dipole_neighbors < 1 || p->dipole_neighbors > 1024)
     return bad_field(message, size, "dipole_neighbors must be in [1, 1024] (got %zu)",
                      p->dipole_neighbors);
+  if (p->dipole_restarts < 1 || p->dipole_restarts > 64)
+    return bad_field(message, size, "dipole_restarts must be in [1, 64] (got %zu)",
+                     p->dipole_restarts);
+  if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
+    return bad_field(message, size, "dipole_final_sweep must be in [0, 1000] (got %d)",
+                     p->dipole_final_sweep);
   if (p->ipsr_max_iterations > 1000)
     return bad_field(message, size, "ipsr_max_iterations must be <= 1000 (got %zu)",
                      p->ipsr_max_iterations);
@@ -138,7 +145,8 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (p->num_threads > 1024)
     return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
   if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&
-      p->disconnected != DACPO_DISCONNECTED_ERROR && p->disconnected != DACPO_DISCONNECTED_BRIDGE)
+      p->disconnected != DACPO_DISCONNECTED_ERROR && p->disconnected != DACPO_DISCONNECTED_BRIDGE &&
+      p->disconnected != DACPO_DISCONNECTED_VIEWPOINT)
     return bad_field(message, size, "disconnected has an unknown value %d", (int)p->disconnected);
   return DACPO_OK;
 }

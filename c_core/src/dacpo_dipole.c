@@ -14,12 +14,16 @@
  * sum of these cached numbers. M randomized BFS orders over the (symmetrized)
  * graph_k-NN graph each give a greedy sign vector (Eq. 4); the M vectors are
  * aligned by an exhaustive search over relative flips (minimum total Hamming
- * disagreement) and majority-voted; an optional Gauss-Seidel sweep then lets
- * every point re-decide with all its K neighbours placed.
+ * disagreement) and majority-voted; Gauss-Seidel sweeps then let every point
+ * re-decide with all its K neighbours placed, until none changes. The whole
+ * run is repeated `restarts` times with other orders and the result with the
+ * highest block energy sum_i s_i sum_t s_j e_ji is kept: a block whose first
+ * run went wrong on one side (half the block against the other half) has a
+ * lower energy than a consistent run, so one unlucky start no longer decides.
  *
  * Cost: kd-tree build O(n log n) + n queries of K+1 neighbours, then
- * O(M n K) for the orders, O(M^2 n + 2^(M-1) M^2) for the alignment, O(n K) for
- * the sweep. Memory: n K (int32 + double) + O(M n) bytes.
+ * restarts x (O(M n K) for the orders, O(M^2 n + 2^(M-1) M^2) for the alignment,
+ * O(n K) per sweep). Memory: n K (int32 + double) + O(M n) bytes.
  *
  * Failures: INVALID_ARGUMENT (NULL pointers, orders outside [1, 16], neighbors
  * == 0, n too large for int32 indices), OUT_OF_MEMORY. Non-finite input is the
@@ -68,6 +72,7 @@ typedef struct dipole_work {
   size_t* gstart;   /* n+1 CSR of the symmetrized graph_k-NN graph */
   int32_t* gnbr;    /* gstart[n] */
   int8_t* sign;     /* M*n sign vectors, 0 = not yet placed */
+  int8_t* cand;     /* n: a restart's result while the best is kept */
   uint8_t* visited; /* n */
   int32_t* queue;   /* n BFS queue = placement order */
   int32_t* order0;  /* n placement order of order 0 (final sweep) */
@@ -86,6 +91,7 @@ dipole_work_free(dipole_work* wk)
   free(wk->gstart);
   free(wk->gnbr);
   free(wk->sign);
+  free(wk->cand);
   free(wk->visited);
   free(wk->queue);
   free(wk->order0);
@@ -403,7 +409,8 @@ dacpo_dipole_orient(const double* xyz,
     wk.queue = dacpo_malloc_array(n, sizeof(int32_t));
     wk.order0 = dacpo_malloc_array(n, sizeof(int32_t));
     wk.perm = dacpo_malloc_array(n, sizeof(int32_t));
-    if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm)
+    wk.cand = dacpo_malloc_array(n, sizeof(int8_t));
+    if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm || !wk.cand)
       st = DACPO_OOM(err);
   }
   if (st != DACPO_OK) {
@@ -411,33 +418,52 @@ dacpo_dipole_orient(const double* xyz,
     return st;
   }
 
-  for (size_t m = 0; m < M; ++m) {
-    dacpo_rng rng;
-    dacpo_rng_seed(&rng, params->seed, params->stream * 1000003u + m);
-    dipole_one_order(&wk, n, K, &rng, wk.sign + m * n, m == 0 ? wk.order0 : NULL);
-  }
-
-  /* Align, then majority vote; a tie keeps order 0's sign. */
-  const unsigned flip = dipole_align(wk.sign, n, M);
-  for (size_t i = 0; i < n; ++i) {
-    int votes = 0;
-    for (size_t m = 0; m < M; ++m)
-      votes += ((flip >> m) & 1u) ? -wk.sign[m * n + i] : wk.sign[m * n + i];
-    sign_out[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk.sign[i];
-  }
-
-  /* Gauss-Seidel sweep in order 0's BFS order: every point now sees all K
-   * neighbours placed; an exact tie keeps the voted sign. */
-  if (params->final_sweep) {
-    for (size_t o = 0; o < n; ++o) {
-      const size_t i = (size_t)wk.order0[o];
-      const int32_t* row = wk.nb + i * K;
-      const double* wrow = wk.w + i * K;
-      const double sum = dipole_field_sum(row, wrow, K, sign_out);
-      if (sum > 0.0)
-        sign_out[i] = 1;
-      else if (sum < 0.0)
-        sign_out[i] = -1;
+  /* Restarts (each: M orders, aligned, voted, then swept) are scored by the
+   * block's own energy sum_i sum_t s_i s_j e_ij (Eq. 4 summed over all pairs,
+   * the quantity every greedy decision tries to raise); the most
+   * self-consistent one is kept, so one unlucky start no longer decides the
+   * block. */
+  const size_t R = params->restarts ? params->restarts : 1;
+  double best_energy = -HUGE_VAL;
+  for (size_t r = 0; r < R; ++r) {
+    int8_t* cand = r == 0 ? sign_out : wk.cand;
+    for (size_t m = 0; m < M; ++m) {
+      dacpo_rng rng;
+      dacpo_rng_seed(&rng, params->seed + 7919u * r, params->stream * 1000003u + m);
+      dipole_one_order(&wk, n, K, &rng, wk.sign + m * n, m == 0 ? wk.order0 : NULL);
+    }
+    /* Align, then majority vote; a tie keeps order 0's sign. */
+    const unsigned flip = dipole_align(wk.sign, n, M);
+    for (size_t i = 0; i < n; ++i) {
+      int votes = 0;
+      for (size_t m = 0; m < M; ++m)
+        votes += ((flip >> m) & 1u) ? -wk.sign[m * n + i] : wk.sign[m * n + i];
+      cand[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk.sign[i];
+    }
+    /* Gauss-Seidel sweeps in order 0's BFS order: every point now sees all K
+     * neighbours placed; an exact tie keeps the voted sign. Repeated (up to
+     * `sweeps` times) until no point changes: each change raises the energy. */
+    for (int sw = 0; sw < params->final_sweep; ++sw) {
+      size_t changed = 0;
+      for (size_t o = 0; o < n; ++o) {
+        const size_t i = (size_t)wk.order0[o];
+        const double sum = dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
+        const int8_t v = sum > 0.0 ? 1 : sum < 0.0 ? -1 : cand[i];
+        changed += v != cand[i];
+        cand[i] = v;
+      }
+      if (changed == 0)
+        break;
+    }
+    if (R == 1)
+      break;
+    double energy = 0.0;
+    for (size_t i = 0; i < n; ++i)
+      energy += (double)cand[i] * dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
+    if (energy > best_energy) {
+      best_energy = energy;
+      if (cand != sign_out)
+        memcpy(sign_out, cand, n);
     }
   }
   dipole_work_free(&wk);

@@ -11,7 +11,10 @@ typedef struct dacpo_dipole_params {
   size_t orders;      /* M randomized BFS orders */
   size_t neighbors;   /* K nearest placed points summed per decision */
   size_t graph_k;     /* k of the BFS graph */
-  int final_sweep;    /* one re-decision sweep with all neighbours placed */
+  int final_sweep;    /* re-decision sweeps with all neighbours placed (until
+                         none changes, at most this many; 0 = none) */
+  size_t restarts;    /* independent runs of the M orders; the one with the
+                         highest block energy is kept (0 or 1 = one run) */
   uint64_t seed;
   uint64_t stream;    /* e.g. the block id: independent of thread count */
   double noise_band;  /* 0 = off; else pairs whose offsets along both normals are

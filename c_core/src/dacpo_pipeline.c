@@ -10,6 +10,7 @@
  * normals are written only after everything succeeded. */
 #include "dacpo_block_graph.h"
 #include "dacpo_bridge.h"
+#include "dacpo_component_sign.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
 #include "dacpo_ilp.h"
@@ -47,6 +48,8 @@ typedef struct run_state {
   dacpo_ipsr_stats* ipsr;  /* per block */
   double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;          /* per block */
+  int8_t* comp_sign;       /* per input component (VIEWPOINT policy) */
+  double* comp_conf;       /* per input component */
   dacpo_ilp_result ilp;
 } run_state;
 
@@ -70,6 +73,8 @@ run_state_free(run_state* s)
   free(s->ipsr);
   free(s->block_seconds);
   free(s->flips);
+  free(s->comp_sign);
+  free(s->comp_conf);
 }
 
 /* Calls the progress callback; non-zero means the caller asked to stop. */
@@ -187,6 +192,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.seed = s->p.seed;
   dp.stream = (uint64_t)b;
   dp.noise_band = s->p.dipole_noise_band;
+  dp.restarts = s->p.dipole_restarts;
   double t0 = dacpo_now();
   st = dacpo_dipole_orient(xyz, nrm, n, &dp, sign, err);
   double t1 = dacpo_now();
@@ -251,17 +257,48 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
     free(ie);
     return DACPO_OOM(err);
   }
+  const double scale = dacpo_edge_evidence_scale(&s->bgraph);
   for (size_t e = 0; e < ne; ++e) {
     const dacpo_block_edge* be = &s->bgraph.edges[e];
     ie[e].a = be->a;
     ie[e].b = be->b;
-    dacpo_edge_omega(be->alpha, be->alpha_bar, &ie[e].w_same, &ie[e].w_diff);
+    dacpo_edge_omega(be->alpha, be->alpha_bar, scale, &ie[e].w_same, &ie[e].w_diff);
     if (be->alpha == 0.0 && be->alpha_bar == 0.0)
       st->zero_weight_edges++;
   }
   dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks, ne, ie, s->p.solver_time_limit,
                                    s->progress, s->flips, &s->ilp, err);
   free(ie);
+  return r;
+}
+
+/* ---- relative sign of disconnected parts -------------------------------- */
+
+static dacpo_status
+relate_components(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const size_t n = s->cloud.n, nc = s->num_components;
+  s->comp_sign = dacpo_malloc_array(nc, sizeof(int8_t));
+  s->comp_conf = dacpo_malloc_array(nc, sizeof(double));
+  double* final = dacpo_malloc_array(3 * n, sizeof(double));
+  if (!s->comp_sign || !s->comp_conf || !final) {
+    free(final);
+    return DACPO_OOM(err);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const double f = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
+    for (int d = 0; d < 3; ++d)
+      final[3 * i + d] = f * s->oriented[3 * i + d];
+  }
+  dacpo_status r = dacpo_component_signs(s->cloud.xyz, final, n, s->input_component, nc,
+                                         s->p.seed, s->comp_sign, s->comp_conf, &st->view_score,
+                                         err);
+  free(final);
+  /* the largest component has confidence 1 by definition; count the others */
+  size_t related = 0;
+  for (size_t c = 0; c < nc; ++c)
+    related += s->comp_conf[c] > 0.0;
+  st->components_related = related > 0 ? related - 1 : 0;
   return r;
 }
 
@@ -353,6 +390,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     }
     double dot = axis[0] * o[0] + axis[1] * o[1] + axis[2] * o[2];
     double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip;
+    if (s->comp_sign)
+      sign *= (double)s->comp_sign[s->input_component[i]];
     for (int d = 0; d < 3; ++d)
       normals[3 * j + d] = (float)(sign * axis[d]);
     ctx->point_component[j] = s->input_component[i];
@@ -480,6 +519,8 @@ run(dacpo_ctx* ctx,
   STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
 
   DACPO_TRY(solve_flips(s, st, err));
+  if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT && s->num_components > 1)
+    DACPO_TRY(relate_components(s, st, err));
   STAGE_DONE(DACPO_STAGE_ILP);
 
   DACPO_TRY(publish(ctx, s, normals, err));

@@ -84,22 +84,6 @@ dacpo_vcr_params_default(dacpo_vcr_params* p)
 }
 
 void
-dacpo_vcr_omega(
-    double alpha, double alpha_bar, double eps, double* w_same, double* w_differ)
-{
-  double den = alpha + alpha_bar + eps;
-  double s = 0.0, d = 0.0;
-  if (den > 0.0 && isfinite(den)) {
-    s = alpha / den;
-    d = alpha_bar / den;
-  }
-  if (w_same != NULL)
-    *w_same = s;
-  if (w_differ != NULL)
-    *w_differ = d;
-}
-
-void
 dacpo_vcr_view_directions(size_t num_views, double* dirs)
 {
   if (dirs == NULL)

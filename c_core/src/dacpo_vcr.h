@@ -50,18 +50,6 @@ dacpo_vcr_edge(const dacpo_mesh* a,
 
 /* ---- additions (stage 4) ------------------------------------------------ */
 
-/* The epsilon of paper Eq. 7 for alpha values as dacpo_vcr_edge scales them
- * (pixel counts divided by image_size^2, boundary counts by image_size; one
- * boundary pixel between two one-pixel regions is ~1e-13 at 400 x 400). */
-#define DACPO_VCR_EPSILON 1e-15
-
-/* Paper Eq. 7: w_same = alpha / (alpha + alpha_bar + eps), w_differ =
- * alpha_bar / (alpha + alpha_bar + eps). Both 0 when the edge carries no
- * evidence. NULL outputs are skipped. */
-void
-dacpo_vcr_omega(
-    double alpha, double alpha_bar, double eps, double* w_same, double* w_differ);
-
 /* Unit view directions used for num_views views (the camera looks along them):
  * num_views <= 12: the first num_views of the 12 icosahedron vertex directions
  * (= dodecahedron face centres), ordered so that the first 6 are one of each

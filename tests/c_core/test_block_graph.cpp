@@ -157,7 +157,7 @@ TEST(DacpoBlockGraph, DipoleWeightsFavourConsistentBlocks)
   for (size_t e = 0; e < g.num_edges; ++e) {
     const dacpo_block_edge& ed = g.edges[e];
     double w_same = -1, w_diff = -1;
-    dacpo_edge_omega(ed.alpha, ed.alpha_bar, &w_same, &w_diff);
+    dacpo_edge_omega(ed.alpha, ed.alpha_bar, 0.0, &w_same, &w_diff);
     EXPECT_GE(w_same, 0.0);
     EXPECT_LE(w_same, 1.0);
     EXPECT_GE(w_diff, 0.0);
@@ -241,17 +241,45 @@ TEST(DacpoBlockGraph, DipoleWeightsOnThinSheetWantOppositeNormals)
 TEST(DacpoBlockGraph, OmegaOfEq7)
 {
   double ws = -1, wd = -1;
-  dacpo_edge_omega(3.0, 1.0, &ws, &wd);
+  dacpo_edge_omega(3.0, 1.0, 0.0, &ws, &wd); // scale 0: Eq. 7 as printed
   EXPECT_NEAR(ws, 0.75, 1e-12);
   EXPECT_NEAR(wd, 0.25, 1e-12);
   EXPECT_LE(ws + wd, 1.0);
-  dacpo_edge_omega(0.0, 0.0, &ws, &wd); // no evidence: zero, not NaN
+  dacpo_edge_omega(0.0, 0.0, 1.0, &ws, &wd); // no evidence: zero, not NaN
   EXPECT_EQ(ws, 0.0);
   EXPECT_EQ(wd, 0.0);
-  dacpo_edge_omega(1e-300, 0.0, &ws, &wd);
-  EXPECT_GE(ws, 0.0);
-  EXPECT_LE(ws, 1.0);
-  dacpo_edge_omega(1.0, 2.0, nullptr, nullptr); // NULL-safe
+  dacpo_edge_omega(1e-300, 0.0, 0.0, &ws, &wd); // tiny evidence keeps its ratio (no eps)
+  EXPECT_NEAR(ws, 1.0, 1e-12);
+  dacpo_edge_omega(HUGE_VAL, 1.0, 1.0, &ws, &wd); // not finite: no evidence
+  EXPECT_EQ(ws, 0.0);
+  EXPECT_EQ(wd, 0.0);
+  dacpo_edge_omega(1.0, 2.0, 1.0, nullptr, nullptr); // NULL-safe
+}
+
+TEST(DacpoBlockGraph, OmegaKeepsTheAmountOfEvidence)
+{
+  // Same ratio, 1000x less evidence than a typical edge: same confidence, about
+  // 1/1000 of the weight; a typical edge keeps half of Eq. 7's weight, a strong
+  // one almost all of it.
+  double ws = 0, wd = 0, ts = 0, td = 0, bs = 0, bd = 0;
+  dacpo_edge_omega(0.9e-3, 0.1e-3, 1.0, &ws, &wd);
+  dacpo_edge_omega(0.9, 0.1, 1.0, &ts, &td);
+  dacpo_edge_omega(900.0, 100.0, 1.0, &bs, &bd);
+  EXPECT_NEAR(ws / (ws + wd), 0.9, 1e-12);
+  EXPECT_NEAR(ws + wd, 1e-3 / (1.0 + 1e-3), 1e-12);
+  EXPECT_NEAR(ts + td, 0.5, 1e-12);
+  EXPECT_NEAR(bs + bd, 1000.0 / 1001.0, 1e-12);
+  EXPECT_GT((ts - td) / (ws - wd), 400.0);
+}
+
+TEST(DacpoBlockGraph, EvidenceScaleIsTheMedianOfEdgesWithEvidence)
+{
+  dacpo_block_edge e[4] = {{0, 1, 1, 1.0, 0.0}, {0, 2, 1, 0.0, 0.0}, {1, 2, 1, 2.0, 1.0},
+                           {2, 3, 1, 5.0, 5.0}};
+  dacpo_block_graph g = {4, e};
+  EXPECT_DOUBLE_EQ(dacpo_edge_evidence_scale(&g), 3.0); // median of {1, 3, 10}
+  g.num_edges = 0;
+  EXPECT_EQ(dacpo_edge_evidence_scale(&g), 0.0);
 }
 
 TEST(DacpoBlockGraph, SingleBlockAndEmptyInputHaveNoEdges)

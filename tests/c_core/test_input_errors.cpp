@@ -456,7 +456,10 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"solver_time_limit", [](dacpo_params* p) { p->solver_time_limit = 0.0; }},
       {"edge_weight", [](dacpo_params* p) { p->edge_weight = static_cast<dacpo_edge_weight>(7); }},
       {"disconnected",
-       [](dacpo_params* p) { p->disconnected = static_cast<dacpo_disconnected_policy>(3); }},
+       [](dacpo_params* p) { p->disconnected = static_cast<dacpo_disconnected_policy>(9); }},
+      {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 0; }},
+      {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 65; }},
+      {"dipole_final_sweep", [](dacpo_params* p) { p->dipole_final_sweep = -1; }},
       {"normal_k",
        [](dacpo_params* p) {
          p->estimate_normals = 1;
@@ -664,7 +667,7 @@ TEST(DacpoInputErrors, DisconnectedComponentsAreOrientedSeparately)
   Cloud c = twoPlanes();
   dacpo_params p;
   dacpo_params_init(&p);
-  ASSERT_EQ(p.disconnected, DACPO_DISCONNECTED_SEPARATE);
+  p.disconnected = DACPO_DISCONNECTED_SEPARATE;
   ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
                          c.size()),
             DACPO_OK)
@@ -688,6 +691,36 @@ TEST(DacpoInputErrors, DisconnectedComponentsAreOrientedSeparately)
     (i % 2 ? blocks_b : blocks_a).insert(block[i]);
   for (int32_t b : blocks_a)
     EXPECT_EQ(blocks_b.count(b), 0u) << "block " << b << " spans both components";
+}
+
+TEST(DacpoInputErrors, DisconnectedPartsAreRelatedByDefault)
+{
+  // Two planes 100 m apart, each given with random signs: by default the far
+  // part takes the sign under which it faces the same side as the larger one.
+  Cloud c = twoPlanes();
+  for (size_t i = 0; i < c.size(); ++i)
+    if ((i * 2654435761u) % 7 < 3)
+      for (int d = 0; d < 3; ++d)
+        c.nrm[3 * i + d] = -c.nrm[3 * i + d];
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    SCOPED_TRACE(seed);
+    auto ctx = makeCtx();
+    dacpo_params p;
+    dacpo_params_init(&p);
+    ASSERT_EQ(p.disconnected, DACPO_DISCONNECTED_VIEWPOINT);
+    p.seed = seed;
+    Cloud out = c;
+    ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, out.xyz.data(), out.nrm.data(),
+                           out.size()),
+              DACPO_OK)
+        << lastError(ctx.get());
+    const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
+    EXPECT_EQ(st->num_components, 2u);
+    EXPECT_EQ(st->components_related, 1u);
+    EXPECT_GT(st->view_score, 0.99);
+    for (size_t i = 1; i < out.size(); ++i)
+      ASSERT_EQ(out.nrm[3 * i + 2], out.nrm[2]) << i;
+  }
 }
 
 TEST(DacpoInputErrors, DisconnectedPolicyErrorFails)

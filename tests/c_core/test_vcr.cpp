@@ -13,6 +13,7 @@
 #include <vector>
 
 extern "C" {
+#include "dacpo_block_graph.h"
 #include "dacpo_vcr.h"
 }
 
@@ -294,7 +295,7 @@ name(const dacpo_vcr_params& p)
 
 } // namespace
 
-TEST(DacpoVcr, DefaultsAndOmega)
+TEST(DacpoVcr, Defaults)
 {
   dacpo_vcr_params p;
   dacpo_vcr_params_default(&p);
@@ -302,13 +303,6 @@ TEST(DacpoVcr, DefaultsAndOmega)
   EXPECT_EQ(p.num_views, 12u);
   EXPECT_EQ(p.perspective, 0);
   EXPECT_EQ(p.boundary_factor, 1);
-  double s, d;
-  dacpo_vcr_omega(3.0, 1.0, 0.0, &s, &d);
-  EXPECT_DOUBLE_EQ(s, 0.75);
-  EXPECT_DOUBLE_EQ(d, 0.25);
-  dacpo_vcr_omega(0.0, 0.0, DACPO_VCR_EPSILON, &s, &d);
-  EXPECT_EQ(s, 0.0);
-  EXPECT_EQ(d, 0.0);
 }
 
 TEST(DacpoVcr, ViewDirectionsAreTheIcosahedronVertices)
@@ -719,7 +713,7 @@ TEST(DacpoVcr, RoomBlocksWithRandomFlipsAreRealigned)
         continue;
       Result r = edge(blocks[i], blocks[j]);
       E e{i, j, 0, 0};
-      dacpo_vcr_omega(r.alpha, r.alpha_bar, DACPO_VCR_EPSILON, &e.same, &e.differ);
+      dacpo_edge_omega(r.alpha, r.alpha_bar, 0.0, &e.same, &e.differ);
       edges.push_back(e);
     }
   EXPECT_GE(edges.size(), 16u);

@@ -136,20 +136,24 @@ printHelp(int, char** argv)
              "(trimmed iPSR\n"
              "                                   block meshes, wound like the output "
              "normals)\n");
-  print_info("                     -mesh F.ply = also write the reconstructed surface "
-             "(trimmed iPSR\n"
-             "                                   block meshes, wound like the output "
-             "normals)\n");
+  print_info("                     -separate   = disconnected parts keep the sign they "
+             "got (undefined relative sign)\n"
+             "                                   (default: each part takes the sign that "
+             "faces the viewpoint\n"
+             "                                   implied by the largest part)\n");
   print_info("                     -bridge     = join disconnected parts along their "
              "minimum spanning tree\n"
-             "                                   and orient them as one (default: each "
-             "part on its own)\n");
+             "                                   and orient them as one\n");
   print_info("                     -band X     = dipole noise band, 0 = off (default: ");
   print_value("%g", d.dipole_noise_band);
   print_info(")\n");
   print_info("                     -orders X   = randomized dipole propagation orders "
              "(default: ");
   print_value("%zu", d.dipole_orders);
+  print_info(")\n");
+  print_info("                     -restarts X = dipole runs per block, the most "
+             "self-consistent kept (default: ");
+  print_value("%zu", d.dipole_restarts);
   print_info(")\n");
   print_info(
       "                     -ring X     = block overlap ring in k-NN hops (default: ");
@@ -615,7 +619,7 @@ parseOptions(int argc, char** argv, Options& o)
   std::uint64_t k = o.params.k, normal_k = o.params.normal_k,
                 blocks = o.params.num_blocks, orders = o.params.dipole_orders,
                 ring = o.params.ring_hops, seed = o.params.seed,
-                threads = o.params.num_threads;
+                threads = o.params.num_threads, restarts = o.params.dipole_restarts;
   double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
          band = o.params.dipole_noise_band;
   if (!dacpo_tool::parseUnsigned(argc, argv, "-vcr_size", vcr_size, error) ||
@@ -624,6 +628,7 @@ parseOptions(int argc, char** argv, Options& o)
       !dacpo_tool::parseUnsigned(argc, argv, "-normal_k", normal_k, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-blocks", blocks, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-orders", orders, error) ||
+      !dacpo_tool::parseUnsigned(argc, argv, "-restarts", restarts, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-ring", ring, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-seed", seed, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-threads", threads, error) ||
@@ -642,6 +647,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.params.normal_k = normal_k;
   o.params.num_blocks = blocks;
   o.params.dipole_orders = orders;
+  o.params.dipole_restarts = restarts;
   o.params.ring_hops = ring;
   o.params.seed = seed;
   o.params.num_threads = static_cast<unsigned>(threads);
@@ -669,6 +675,8 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
+  if (find_switch(argc, argv, "-separate"))
+    o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
   if (find_switch(argc, argv, "-bridge"))
     o.params.disconnected = DACPO_DISCONNECTED_BRIDGE;
   o.estimate = find_switch(argc, argv, "-estimate");
@@ -773,13 +781,16 @@ main(int argc, char** argv)
       }));
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
-               "components=%zu flipped=%zu solver_optimal=%d ipsr_iterations_mean=%.2f "
+               "components=%zu components_related=%zu view_score=%.3f flipped=%zu "
+               "solver_optimal=%d ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
                s.num_blocks,
                s.num_block_edges,
                low,
                s.num_components,
+               s.components_related,
+               s.view_score,
                s.flipped_blocks,
                s.solver_optimal ? 1 : 0,
                s.num_blocks ? static_cast<double>(s.ipsr_iterations_total) /

@@ -100,7 +100,13 @@ typedef enum dacpo_disconnected_policy {
   /** Join the components by bridge edges along their Euclidean minimum spanning
    *  tree (closest point pairs, plus a few nearby pairs per bridge) and orient
    *  the whole cloud as one; the bridges are counted in dacpo_stats. */
-  DACPO_DISCONNECTED_BRIDGE = 2
+  DACPO_DISCONNECTED_BRIDGE = 2,
+  /** Orient every component on its own, then give each the sign under which
+   *  most of its points face the viewpoint that the largest (oriented)
+   *  component implies. Per-component vote margins are the confidences
+   *  (dacpo_ctx_component_confidence); when no viewpoint explains the largest
+   *  component the parts stay unrelated (confidence 0, as SEPARATE). */
+  DACPO_DISCONNECTED_VIEWPOINT = 3
 } dacpo_disconnected_policy;
 
 /**
@@ -125,7 +131,8 @@ typedef struct dacpo_params {
                           got 9 % wrong. */
   size_t dipole_orders;    /**< M randomized BFS orders (5) */
   size_t dipole_neighbors; /**< K nearest placed points summed per decision (32) */
-  int dipole_final_sweep;  /**< 1: one re-decision sweep after voting (1) */
+  int dipole_final_sweep;  /**< re-decision sweeps after voting, repeated until no
+                                point changes, at most this many; 0 = none (10) */
   int ipsr_enabled;        /**< stage 3 on/off (1) */
   size_t ipsr_max_iterations; /**< (20) */
   dacpo_edge_weight edge_weight; /**< (DACPO_WEIGHT_VCR; with iPSR off the blocks
@@ -133,7 +140,7 @@ typedef struct dacpo_params {
   double solver_time_limit; /**< seconds for the 0-1 program (30) */
   uint64_t seed;            /**< all randomness derives from it (1) */
   unsigned num_threads;     /**< 0 = all cores (0) */
-  dacpo_disconnected_policy disconnected; /**< (SEPARATE) */
+  dacpo_disconnected_policy disconnected; /**< (VIEWPOINT) */
   double dipole_noise_band; /**< pairs whose offsets along both normals are
                                  below this many times the block's noise scale
                                  (median RMS offset of neighbours from the
@@ -149,6 +156,9 @@ typedef struct dacpo_params {
                                other counts use a Fibonacci sphere, [1, 256] (12) */
   int vcr_perspective;    /**< 1: perspective projection (paper); 0: orthographic (0) */
   int vcr_boundary_factor; /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
+  size_t dipole_restarts; /**< independent runs of stage 2 per block (M orders
+                               each); the one with the highest block energy
+                               (Eq. 4 summed over all pairs) is kept, 1..64 (4) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -223,6 +233,10 @@ typedef struct dacpo_stats {
   size_t peak_block_points; /**< largest block incl. ring */
   size_t bridges_added;     /**< bridge edges added (DACPO_DISCONNECTED_BRIDGE) */
   double longest_bridge;    /**< length of the longest bridge edge */
+  double view_score;        /**< DACPO_DISCONNECTED_VIEWPOINT: share of the largest
+                                 component facing the inferred viewpoint (0 if unused) */
+  size_t components_related; /**< components other than the largest whose sign was
+                                  set by the viewpoint vote (confidence > 0) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

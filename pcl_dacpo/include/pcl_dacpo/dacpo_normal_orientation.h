@@ -56,9 +56,11 @@ namespace pcl {
  * normal, are skipped: they get NaN normals and curvature, and the output is
  * then not dense.
  *
- * Several connected components of the k-NN graph are oriented separately (their
- * relative sign is undefined) unless setDisconnectedPolicy() says otherwise; a
- * PCL_WARN reports the count, getComponentLabels() tells them apart.
+ * Several connected components of the k-NN graph are oriented separately, then
+ * each takes the sign under which its points face the viewpoint implied by the
+ * largest component (DACPO_DISCONNECTED_VIEWPOINT, the default);
+ * setDisconnectedPolicy() chooses otherwise. A PCL_WARN reports the count and how
+ * many parts were related; getComponentLabels() tells them apart.
  *
  * Runs with the same parameters and seed give identical output, also with a
  * different number of threads.
@@ -217,11 +219,12 @@ public:
     return params_.dipole_neighbors;
   }
 
-  /** \brief One re-decision sweep after the vote of the orders (default true). */
+  /** \brief Re-decision sweeps after the vote of the orders, repeated until no
+   *  point changes (at most 10; default true). */
   void
   setDipoleFinalSweep(bool enabled)
   {
-    params_.dipole_final_sweep = enabled ? 1 : 0;
+    params_.dipole_final_sweep = enabled ? 10 : 0;
   }
   /** \brief See setDipoleFinalSweep(). */
   bool
@@ -314,7 +317,22 @@ public:
     return params_.num_threads;
   }
 
-  /** \brief What to do with a disconnected k-NN graph (default: orient separately). */
+  /** \brief Independent runs of the dipole stage per block; the most
+   *  self-consistent (highest block energy) is kept (default 4). */
+  void
+  setDipoleRestarts(std::size_t restarts)
+  {
+    params_.dipole_restarts = restarts;
+  }
+  /** \brief See setDipoleRestarts(). */
+  std::size_t
+  getDipoleRestarts() const
+  {
+    return params_.dipole_restarts;
+  }
+
+  /** \brief What to do with a disconnected k-NN graph (default: relate the parts
+   *  by the viewpoint the largest one implies, DACPO_DISCONNECTED_VIEWPOINT). */
   void
   setDisconnectedPolicy(dacpo_disconnected_policy policy)
   {

@@ -407,6 +407,15 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
              stats_.num_components,
              stats_.bridges_added,
              stats_.longest_bridge);
+  else if (stats_.num_components > 1 && params_.disconnected == DACPO_DISCONNECTED_VIEWPOINT)
+    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
+             "components (largest %zu points); %zu of the others were related to it by "
+             "the viewpoint it implies (score %.2f), the rest keep an undefined sign.\n",
+             getClassName().c_str(),
+             stats_.num_components,
+             stats_.largest_component,
+             stats_.components_related,
+             stats_.view_score);
   else if (stats_.num_components > 1)
     PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
              "components (largest %zu points); each is oriented on its own, their "
