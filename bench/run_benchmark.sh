@@ -6,6 +6,10 @@
 #   bench/run_benchmark.sh --scaling       # quick scaling run: 50K .. 1M points
 #   bench/run_benchmark.sh --all           # both
 #   bench/run_benchmark.sh --full --all    # 500K rooms, 3 seeds, scaling up to 4M (hours)
+#   bench/run_benchmark.sh --robustness [robustness.py options] [DIR ...]
+#                                          # every ground-truth PLY of DIR (default:
+#                                          # ../shared/data and ../shared/rooms) x seeds
+#                                          # 1-5: median, worst, spread, error split
 #
 # Accuracy suite: generated rooms in the paper's variants (clean, Gaussian noise
 # sigma 0.004 / 0.008, random downsampling to 100K / 10K) and every PLY in
@@ -25,6 +29,15 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if ! command -v python3 >/dev/null 2>&1; then
   echo "run_benchmark: python3 is needed (standard library only)" >&2
   exit 1
+fi
+if [ "${1:-}" = "--robustness" ]; then
+  shift
+  has_input=0
+  for a in "$@"; do case "$a" in -*) ;; *) [ -e "$a" ] && has_input=1 ;; esac; done
+  if [ "$has_input" = 0 ]; then
+    set -- "$@" "$root/../shared/data" "$root/../shared/rooms"
+  fi
+  exec python3 "$root/bench/robustness.py" "$@"
 fi
 exec python3 - "$root" "$@" <<'PY'
 import json, math, os, platform, re, shlex, shutil, signal, subprocess, sys, time

@@ -181,6 +181,7 @@ dacpo_ctx_clear_results(dacpo_ctx* ctx)
   free(ctx->point_component);
   free(ctx->point_block);
   free(ctx->point_curvature);
+  free(ctx->point_confidence);
   free(ctx->block_flips);
   free(ctx->edges);
   free(ctx->mesh_vertices);
@@ -192,6 +193,7 @@ dacpo_ctx_clear_results(dacpo_ctx* ctx)
   ctx->point_component = NULL;
   ctx->point_block = NULL;
   ctx->point_curvature = NULL;
+  ctx->point_confidence = NULL;
   ctx->block_flips = NULL;
   ctx->edges = NULL;
   memset(&ctx->stats, 0, sizeof(ctx->stats));
@@ -241,6 +243,12 @@ const float*
 dacpo_ctx_point_curvature(const dacpo_ctx* ctx)
 {
   return ctx ? ctx->point_curvature : NULL;
+}
+
+const float*
+dacpo_ctx_point_confidence(const dacpo_ctx* ctx)
+{
+  return ctx ? ctx->point_confidence : NULL;
 }
 
 size_t

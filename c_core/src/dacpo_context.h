@@ -11,6 +11,7 @@ struct dacpo_ctx {
   int32_t* point_component; /* input_points */
   int32_t* point_block;     /* input_points */
   float* point_curvature;   /* input_points, only when normals were estimated */
+  float* point_confidence;  /* input_points */
   uint8_t* block_flips;     /* num_blocks */
   dacpo_edge_info* edges;   /* num_block_edges */
   float* mesh_vertices;     /* 3 * mesh_num_vertices (keep_mesh) */

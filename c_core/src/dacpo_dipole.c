@@ -72,7 +72,7 @@ typedef struct dipole_work {
   size_t* gstart;   /* n+1 CSR of the symmetrized graph_k-NN graph */
   int32_t* gnbr;    /* gstart[n] */
   int8_t* sign;     /* M*n sign vectors, 0 = not yet placed */
-  int8_t* cand;     /* n: a restart's result while the best is kept */
+  int8_t* cand;     /* restarts * n: every restart's result */
   uint8_t* visited; /* n */
   int32_t* queue;   /* n BFS queue = placement order */
   int32_t* order0;  /* n placement order of order 0 (final sweep) */
@@ -378,6 +378,51 @@ dacpo_dipole_orient(const double* xyz,
                     int8_t* sign_out,
                     dacpo_err* err)
 {
+  return dacpo_dipole_orient_confidence(xyz, nrm, n, params, sign_out, NULL, err);
+}
+
+/* Confidence of every point in the kept run: the share of restarts that agree
+ * with it (each restart aligned to the kept one as a whole) times the margin of
+ * its final decision, |sum_t s_j e_ji| / sum_t |e_ji| (1: every neighbour says
+ * the same, 0: a tie). */
+static void
+dipole_confidence(const dipole_work* wk, size_t n, size_t K, size_t R, size_t best,
+                  float* confidence)
+{
+  const int8_t* s = wk->cand + best * n;
+  for (size_t i = 0; i < n; ++i)
+    confidence[i] = 0.0f;
+  for (size_t r = 0; r < R; ++r) {
+    const int8_t* c = wk->cand + r * n;
+    size_t same = 0;
+    for (size_t i = 0; i < n; ++i)
+      same += c[i] == s[i];
+    const int8_t f = 2 * same >= n ? 1 : -1;
+    for (size_t i = 0; i < n; ++i)
+      confidence[i] += (float)(f * c[i] == s[i]);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t* row = wk->nb + i * K;
+    const double* w = wk->w + i * K;
+    double sum = 0.0, mag = 0.0;
+    for (size_t t = 0; t < K; ++t) {
+      sum += (double)s[row[t]] * w[t];
+      mag += fabs(w[t]);
+    }
+    const double margin = mag > 0.0 ? fabs(sum) / mag : 0.0;
+    confidence[i] = (float)((double)confidence[i] / (double)R * margin);
+  }
+}
+
+dacpo_status
+dacpo_dipole_orient_confidence(const double* xyz,
+                               const double* nrm,
+                               size_t n,
+                               const dacpo_dipole_params* params,
+                               int8_t* sign_out,
+                               float* confidence,
+                               dacpo_err* err)
+{
   DACPO_CHECK(err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
   if (n == 0)
     return DACPO_OK;
@@ -390,8 +435,12 @@ dacpo_dipole_orient(const double* xyz,
               DACPO_DIPOLE_MAX_ORDERS, params->orders);
   DACPO_CHECK(err, params->neighbors >= 1, DACPO_ERR_INVALID_ARGUMENT,
               "dipole: neighbors must be >= 1");
+  DACPO_CHECK(err, params->restarts <= 64, DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: restarts must be <= 64 (got %zu)", params->restarts);
   if (n == 1) {
     sign_out[0] = 1;
+    if (confidence)
+      confidence[0] = 0.0f;
     return DACPO_OK;
   }
   const size_t K = params->neighbors < n - 1 ? params->neighbors : n - 1;
@@ -409,7 +458,7 @@ dacpo_dipole_orient(const double* xyz,
     wk.queue = dacpo_malloc_array(n, sizeof(int32_t));
     wk.order0 = dacpo_malloc_array(n, sizeof(int32_t));
     wk.perm = dacpo_malloc_array(n, sizeof(int32_t));
-    wk.cand = dacpo_malloc_array(n, sizeof(int8_t));
+    wk.cand = dacpo_malloc_array(n * (params->restarts ? params->restarts : 1), sizeof(int8_t));
     if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm || !wk.cand)
       st = DACPO_OOM(err);
   }
@@ -425,8 +474,9 @@ dacpo_dipole_orient(const double* xyz,
    * block. */
   const size_t R = params->restarts ? params->restarts : 1;
   double best_energy = -HUGE_VAL;
+  size_t best = 0;
   for (size_t r = 0; r < R; ++r) {
-    int8_t* cand = r == 0 ? sign_out : wk.cand;
+    int8_t* cand = wk.cand + r * n;
     for (size_t m = 0; m < M; ++m) {
       dacpo_rng rng;
       dacpo_rng_seed(&rng, params->seed + 7919u * r, params->stream * 1000003u + m);
@@ -462,10 +512,12 @@ dacpo_dipole_orient(const double* xyz,
       energy += (double)cand[i] * dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
     if (energy > best_energy) {
       best_energy = energy;
-      if (cand != sign_out)
-        memcpy(sign_out, cand, n);
+      best = r;
     }
   }
+  memcpy(sign_out, wk.cand + best * n, n);
+  if (confidence)
+    dipole_confidence(&wk, n, K, R, best, confidence);
   dipole_work_free(&wk);
   return DACPO_OK;
 }

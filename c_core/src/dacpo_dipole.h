@@ -39,4 +39,16 @@ dacpo_dipole_orient(const double* xyz,
                     int8_t* sign_out,
                     dacpo_err* err);
 
+/* The same, and confidence[i] in [0, 1] (NULL: not computed): the share of
+ * restarts that agree with point i's sign times the margin of its last
+ * decision (|sum of the neighbours' field| / sum of its magnitudes). */
+dacpo_status
+dacpo_dipole_orient_confidence(const double* xyz,
+                               const double* nrm,
+                               size_t n,
+                               const dacpo_dipole_params* params,
+                               int8_t* sign_out,
+                               float* confidence,
+                               dacpo_err* err);
+
 #endif

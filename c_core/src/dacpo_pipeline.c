@@ -39,15 +39,18 @@ typedef struct run_state {
   int32_t* component;       /* component the stages work with (0 after bridging) */
   int32_t* input_component; /* component of the k-NN graph, as reported */
   size_t num_components;
+  int32_t largest_component_id; /* input component with the most points */
   float* curvature; /* per distinct point, only when estimated */
   dacpo_blocks blocks;
   dacpo_block_graph bgraph;
   double* oriented;        /* 3n: normals after stages 2-3, before flips */
+  float* point_conf;       /* n: in-block confidence (stage 2, halved where stage 3 disagreed) */
   double* ring_oriented;   /* 3 per ring entry: each block's normals of its ring */
   dacpo_mesh* meshes;      /* per block, only for VCR weights */
   dacpo_ipsr_stats* ipsr;  /* per block */
   double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;          /* per block */
+  float* block_conf;       /* per block: how firmly stage 5 holds its flip */
   int8_t* comp_sign;       /* per input component (VIEWPOINT policy) */
   double* comp_conf;       /* per input component */
   dacpo_ilp_result ilp;
@@ -69,10 +72,12 @@ run_state_free(run_state* s)
   dacpo_blocks_free(&s->blocks);
   dacpo_block_graph_free(&s->bgraph);
   free(s->oriented);
+  free(s->point_conf);
   free(s->ring_oriented);
   free(s->ipsr);
   free(s->block_seconds);
   free(s->flips);
+  free(s->block_conf);
   free(s->comp_sign);
   free(s->comp_conf);
 }
@@ -120,8 +125,10 @@ build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo
     sizes[s->component[i]]++;
   st->num_components = s->num_components;
   for (size_t c = 0; c < s->num_components; ++c)
-    if (sizes[c] > st->largest_component)
+    if (sizes[c] > st->largest_component) {
       st->largest_component = sizes[c];
+      s->largest_component_id = (int32_t)c;
+    }
   free(sizes);
   DACPO_CHECK(err, s->num_components == 1 || s->p.disconnected != DACPO_DISCONNECTED_ERROR,
               DACPO_ERR_DISCONNECTED,
@@ -171,8 +178,9 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
   double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
   int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
+  float* conf = dacpo_malloc_array(n, sizeof(float));
   dacpo_status st = DACPO_OK;
-  if (!xyz || !nrm || !sign) {
+  if (!xyz || !nrm || !sign || !conf) {
     st = DACPO_OOM(err);
     goto done;
   }
@@ -194,7 +202,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.noise_band = s->p.dipole_noise_band;
   dp.restarts = s->p.dipole_restarts;
   double t0 = dacpo_now();
-  st = dacpo_dipole_orient(xyz, nrm, n, &dp, sign, err);
+  st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);
   double t1 = dacpo_now();
   s->block_seconds[2 * b] = t1 - t0;
   if (st != DACPO_OK)
@@ -215,8 +223,15 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     if (st != DACPO_OK)
       goto done;
   }
-  for (size_t i = 0; i < no; ++i)
-    memcpy(s->oriented + 3 * (size_t)bl->own[own0 + i], nrm + 3 * i, 3 * sizeof(double));
+  for (size_t i = 0; i < no; ++i) {
+    const size_t q = (size_t)bl->own[own0 + i];
+    memcpy(s->oriented + 3 * q, nrm + 3 * i, 3 * sizeof(double));
+    /* nrm started as sign * axis: a negative dot means stage 3 turned it over */
+    const double* a = s->cloud.nrm + 3 * q;
+    const double d = (a[0] * nrm[3 * i] + a[1] * nrm[3 * i + 1] + a[2] * nrm[3 * i + 2]) *
+                     (double)sign[i];
+    s->point_conf[q] = d >= 0.0 ? conf[i] : 0.5f * conf[i];
+  }
   if (s->ring_oriented)
     memcpy(s->ring_oriented + 3 * ring0, nrm + 3 * no, 3 * nr * sizeof(double));
 done:
@@ -224,6 +239,7 @@ done:
   free(xyz);
   free(nrm);
   free(sign);
+  free(conf);
   return st;
 }
 
@@ -247,6 +263,40 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
 
 /* ---- stage 5 ----------------------------------------------------------- */
 
+/* How firmly the 0-1 program's answer holds each block: flipping block b alone
+ * would lose sum_e (w_kept - w_other) over its edges; divided by sum_e (w_kept +
+ * w_other) this is 1 when every edge agrees with the answer, 0 when flipping b
+ * costs nothing. A block without edges has nothing to decide: 1. */
+static dacpo_status
+block_confidence(run_state* s, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* err)
+{
+  const size_t nb = s->blocks.num_blocks;
+  double* lose = dacpo_calloc_array(nb, sizeof(double));
+  double* total = dacpo_calloc_array(nb, sizeof(double));
+  s->block_conf = dacpo_malloc_array(nb, sizeof(float));
+  if (!lose || !total || !s->block_conf) {
+    free(lose);
+    free(total);
+    return DACPO_OOM(err);
+  }
+  for (size_t e = 0; e < ne; ++e) {
+    const int same = s->flips[ie[e].a] == s->flips[ie[e].b];
+    const double kept = same ? ie[e].w_same : ie[e].w_diff;
+    const double other = same ? ie[e].w_diff : ie[e].w_same;
+    for (int side = 0; side < 2; ++side) {
+      const size_t b = (size_t)(side ? ie[e].b : ie[e].a);
+      lose[b] += kept - other;
+      total[b] += kept + other;
+    }
+  }
+  for (size_t b = 0; b < nb; ++b)
+    s->block_conf[b] =
+        total[b] > 0.0 ? (float)fmin(1.0, fmax(0.0, lose[b] / total[b])) : 1.0f;
+  free(lose);
+  free(total);
+  return DACPO_OK;
+}
+
 static dacpo_status
 solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
@@ -268,6 +318,8 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
   }
   dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks, ne, ie, s->p.solver_time_limit,
                                    s->progress, s->flips, &s->ilp, err);
+  if (r == DACPO_OK)
+    r = block_confidence(s, ie, ne, err);
   free(ie);
   return r;
 }
@@ -341,6 +393,19 @@ publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* Confidence in the sign of point i's component relative to the largest one:
+ * 1 with one component (or bridged into one), the viewpoint vote margin under
+ * the VIEWPOINT policy, 0 for every part but the largest under SEPARATE. */
+static double
+component_confidence(const run_state* s, size_t i)
+{
+  if (s->comp_conf)
+    return s->comp_conf[s->input_component[i]];
+  if (s->num_components <= 1)
+    return 1.0;
+  return s->input_component[i] == s->largest_component_id ? 1.0 : 0.0;
+}
+
 static dacpo_status
 publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 {
@@ -351,9 +416,11 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
   ctx->point_block = dacpo_malloc_array(count, sizeof(int32_t));
   ctx->block_flips = dacpo_malloc_array(s->blocks.num_blocks, sizeof(uint8_t));
   ctx->edges = dacpo_malloc_array(s->bgraph.num_edges, sizeof(dacpo_edge_info));
+  ctx->point_confidence = dacpo_malloc_array(count, sizeof(float));
   if (s->curvature)
     ctx->point_curvature = dacpo_malloc_array(count, sizeof(float));
-  if (!ctx->point_component || !ctx->point_block || !ctx->block_flips || !ctx->edges ||
+  if (!ctx->point_component || !ctx->point_block || !ctx->point_confidence ||
+      !ctx->block_flips || !ctx->edges ||
       (s->curvature && !ctx->point_curvature))
     return DACPO_OOM(err);
 
@@ -396,6 +463,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
       normals[3 * j + d] = (float)(sign * axis[d]);
     ctx->point_component[j] = s->input_component[i];
     ctx->point_block[j] = s->blocks.block_of[i];
+    ctx->point_confidence[j] = s->point_conf[i] * s->block_conf[s->blocks.block_of[i]] *
+                               (float)component_confidence(s, i);
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
@@ -474,6 +543,7 @@ run(dacpo_ctx* ctx,
   /* Stages 2 and 3 share one pass per block (they are independent per block). */
   const size_t nb = s->blocks.num_blocks;
   s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
+  s->point_conf = dacpo_malloc_array(s->cloud.n, sizeof(float));
   s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
   s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
   const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
@@ -482,7 +552,7 @@ run(dacpo_ctx* ctx,
   const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
   if (want_ring)
     s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
-  if (!s->oriented || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes) ||
+  if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes) ||
       (want_ring && !s->ring_oriented))
     return DACPO_OOM(err);
   DACPO_TRY(dacpo_parallel_for(nb, s->p.num_threads, orient_block, s,

@@ -11,6 +11,7 @@
 
 extern "C" {
 #include "dacpo_block_graph.h"
+#include "dacpo_ilp.h"
 }
 
 namespace {
@@ -338,4 +339,38 @@ TEST(DacpoBlockGraph, RejectsInconsistentInput)
                                              &err),
             DACPO_ERR_INVALID_ARGUMENT);
   dacpo_block_graph_free(&g);
+}
+
+TEST(DacpoBlockGraph, TinyContactCannotOutvoteALongSharedBoundary)
+{
+  // A ring of 6 blocks: five long shared boundaries (evidence ~1) all say
+  // "same", one tiny contact (evidence 1e-4, i.e. a few pixels) says "differ"
+  // with full confidence. Under Eq. 7 as printed every edge weighs 1 and the
+  // 0-1 program must break a strong edge as often as the tiny one (a tie); with
+  // the amount of evidence kept, only the tiny contact is overruled.
+  std::vector<dacpo_block_edge> e;
+  for (int32_t b = 0; b + 1 < 6; ++b)
+    e.push_back({b, b + 1, 100, 0.9 + 0.05 * b, 0.01});
+  e.push_back({0, 5, 1, 0.0, 1e-4});
+  dacpo_block_graph g = {e.size(), e.data()};
+  const double scale = dacpo_edge_evidence_scale(&g);
+  std::vector<dacpo_ilp_edge> ie;
+  for (const dacpo_block_edge& be : e) {
+    dacpo_ilp_edge x = {be.a, be.b, 0, 0};
+    dacpo_edge_omega(be.alpha, be.alpha_bar, scale, &x.w_same, &x.w_diff);
+    ie.push_back(x);
+  }
+  uint8_t flips[6];
+  dacpo_ilp_result r;
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_ilp_solve(6, ie.size(), ie.data(), 5.0, nullptr, flips, &r, &err), DACPO_OK)
+      << err.msg;
+  for (int b = 1; b < 6; ++b)
+    EXPECT_EQ(flips[b], flips[0]) << "block " << b;
+  // The same edges under Eq. 7 as printed: breaking the tiny contact is no
+  // better than breaking a long boundary.
+  double ts, td, ls, ld;
+  dacpo_edge_omega(0.0, 1e-4, 0.0, &ts, &td);
+  dacpo_edge_omega(0.9, 0.01, 0.0, &ls, &ld);
+  EXPECT_GT(td - ts, 0.99 * (ls - ld));
 }

@@ -80,6 +80,7 @@ struct Result {
   dacpo_stats stats{};
   std::vector<int32_t> component, block;
   std::vector<float> curvature; // empty when normals were given
+  std::vector<float> confidence;
   std::vector<uint8_t> flips;
   std::vector<dacpo_edge_info> edges;
 };
@@ -107,6 +108,8 @@ orient(dacpo_ctx* ctx,
     r.block.assign(b, b + m);
   if (const float* k = dacpo_ctx_point_curvature(ctx))
     r.curvature.assign(k, k + m);
+  if (const float* c = dacpo_ctx_point_confidence(ctx))
+    r.confidence.assign(c, c + m);
   if (const uint8_t* f = dacpo_ctx_block_flips(ctx))
     r.flips.assign(f, f + r.stats.num_blocks);
   if (const dacpo_edge_info* e = dacpo_ctx_edges(ctx))
@@ -244,6 +247,61 @@ TEST(DacpoPipeline, TwoRoomsBelowMeasuredError)
   EXPECT_LT(wrong, 3.0);
   EXPECT_GE(r.stats.num_blocks, 8u);
   EXPECT_EQ(r.stats.solver_optimal, 1);
+}
+
+// Measured (20K-point room, estimated normals, defaults): seeds 1-5 give 9.31,
+// 11.07, 9.44, 8.96, 9.21 % wrong (spread 2.1 points; most of it on thin
+// furniture inside blocks). Before stage-2 restarts, magnitude-aware edge
+// weights and related parts, single seeds of such rooms swung by up to 22
+// points. The least confident 10 % of the points held 40-44 % of the wrong ones.
+TEST(DacpoPipeline, SeedsOneToFiveAgreeOnAGeneratedRoom)
+{
+  Scene sc;
+  generate(DACPO_SCENE_ROOM, 20000, 1, &sc);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  double lo = 100.0, hi = 0.0;
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    SCOPED_TRACE(seed);
+    p.seed = seed;
+    Result r = orientScene(sc, p);
+    ASSERT_EQ(r.status, DACPO_OK) << r.error;
+    const double wrong = wrongPercent(sc, r);
+    lo = std::min(lo, wrong);
+    hi = std::max(hi, wrong);
+    EXPECT_LT(wrong, 13.0);
+
+    // Confidence: in [0, 1], and the least confident 10 % hold far more than
+    // 10 % of the wrong points.
+    ASSERT_EQ(r.confidence.size(), sc.s.n);
+    std::vector<size_t> order(sc.s.n);
+    for (size_t i = 0; i < sc.s.n; ++i) {
+      order[i] = i;
+      ASSERT_GE(r.confidence[i], 0.0f) << i;
+      ASSERT_LE(r.confidence[i], 1.0f) << i;
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return r.confidence[a] < r.confidence[b]; });
+    // wrong under the sign that makes most points right
+    size_t agree = 0;
+    std::vector<bool> right(sc.s.n);
+    for (size_t i = 0; i < sc.s.n; ++i) {
+      const float* g = sc.s.normals + 3 * i;
+      const float* o = r.normals.data() + 3 * i;
+      right[i] = g[0] * o[0] + g[1] * o[1] + g[2] * o[2] > 0.0f;
+      agree += right[i];
+    }
+    const bool flip = 2 * agree < sc.s.n;
+    size_t wrong_all = 0, wrong_low = 0;
+    for (size_t k = 0; k < sc.s.n; ++k) {
+      const bool w = right[order[k]] == flip;
+      wrong_all += w;
+      wrong_low += w && k < sc.s.n / 10;
+    }
+    EXPECT_GT(static_cast<double>(wrong_low), 0.3 * static_cast<double>(wrong_all));
+  }
+  RecordProperty("seed_spread", std::to_string(hi - lo));
+  EXPECT_LE(hi - lo, 3.0);
 }
 
 // ---- published results --------------------------------------------------------

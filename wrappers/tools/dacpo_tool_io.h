@@ -305,6 +305,19 @@ readInt32Field(const pcl::PCLPointCloud2& cloud, const char* name)
   return out;
 }
 
+/** Reads one named numeric field of every point as float. The field must exist. */
+inline std::vector<float>
+readFloatField(const pcl::PCLPointCloud2& cloud, const char* name)
+{
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const pcl::PCLPointField& field = cloud.fields[pcl::getFieldIndex(cloud, name)];
+  std::vector<float> out(n);
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = static_cast<float>(
+        readValue(&cloud.data[i * cloud.point_step + field.offset], field.datatype));
+  return out;
+}
+
 /** Writes binary-compressed PCD or binary PLY by extension. */
 inline bool
 saveCloud2(const std::string& path,

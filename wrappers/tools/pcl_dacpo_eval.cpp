@@ -448,9 +448,9 @@ main(int argc, char** argv)
     return 1;
   }
 
-  if (!colored.empty()) {
-    /* Per point under the global sign chosen for the all-points score. */
-    std::vector<bool> wrong(n);
+  /* Per point under the global sign chosen for the all-points score. */
+  std::vector<bool> wrong(n);
+  {
     std::size_t wrong_pos = 0, wrong_neg = 0;
     std::vector<double> dot(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -463,6 +463,34 @@ main(int argc, char** argv)
     const bool flip = wrong_neg < wrong_pos;
     for (std::size_t i = 0; i < n; ++i)
       wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
+  }
+
+  /* With a confidence field: which share of the wrong points the least
+   * confident 10 % of the points hold (10 % if confidence says nothing). */
+  const bool has_confidence = dacpo_tool::hasFields(pred2, {"confidence"});
+  double wrong_in_low10 = 0.0, low10_wrong = 0.0;
+  if (has_confidence) {
+    const std::vector<float> conf = dacpo_tool::readFloatField(pred2, "confidence");
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    /* NaN (skipped points) last; ties keep the point order */
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      const float x = std::isnan(conf[a]) ? 2.0f : conf[a];
+      const float y = std::isnan(conf[b]) ? 2.0f : conf[b];
+      return x < y;
+    });
+    const std::size_t low = (n + 9) / 10;
+    std::size_t wrong_total = 0, wrong_low = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      wrong_total += wrong[order[k]];
+      if (k < low)
+        wrong_low += wrong[order[k]];
+    }
+    wrong_in_low10 = wrong_total ? 100.0 * wrong_low / wrong_total : 0.0;
+    low10_wrong = low ? 100.0 * wrong_low / low : 0.0;
+  }
+
+  if (!colored.empty()) {
     if (!saveColored(colored, xyz, pred, wrong)) {
       print_error("Error: cannot write '%s'\n", colored.c_str());
       return 1;
@@ -490,6 +518,11 @@ main(int argc, char** argv)
         sizes[largest],
         pct_largest,
         components);
+    if (has_confidence)
+      std::printf(", \"wrong_in_least_confident10_pct\":%.4f, "
+                  "\"least_confident10_wrong_pct\":%.4f",
+                  wrong_in_low10,
+                  low10_wrong);
     if (has_blocks) {
       std::printf(", \"blocks\":%zu, \"component_wrong_pct\":%.4f, "
                   "\"intra_block_wrong_pct\":%.4f, \"flip_wrong_blocks\":%zu, "
@@ -525,6 +558,13 @@ main(int argc, char** argv)
     print_info(" of ");
     print_value("%zu", sizes[largest]);
     print_info(" points\n");
+    if (has_confidence) {
+      print_info("  The least confident 10%% of the points hold ");
+      print_value("%.1f%%", wrong_in_low10);
+      print_info(" of the wrong ones (");
+      print_value("%.1f%%", low10_wrong);
+      print_info(" of them are wrong)\n");
+    }
     if (has_blocks) {
       print_info("  %zu blocks. Wrong with the best sign per component: ", br.blocks);
       print_value("%.2f%%", br.component_wrong_pct);

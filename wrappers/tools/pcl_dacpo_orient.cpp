@@ -80,6 +80,7 @@ struct Result {
   std::size_t points = 0; /* input points, skipped ones included */
   dacpo_stats stats;
   std::vector<int> blocks, components;
+  std::vector<float> confidence;
   std::vector<std::uint8_t> flips;
   std::vector<dacpo_edge_info> edges;
   std::vector<float> mesh_vertices;
@@ -181,7 +182,9 @@ printHelp(int, char** argv)
   print_value("%u", d.num_threads);
   print_info(")\n");
   print_info("                     -labels     = add int32 fields block, component "
-             "and flip\n");
+             "and flip, and the\n"
+             "                                   float field confidence (0..1, how sure the "
+             "sign is)\n");
   print_info("                                   (flip = 1 if the 0-1 program flipped "
              "the block;\n");
   print_info("                                   all -1 for skipped points); then "
@@ -382,6 +385,7 @@ compute(const pcl::PCLPointCloud2& input,
   result.stats = s;
   result.blocks = dacpo.getBlockLabels();
   result.components = dacpo.getComponentLabels();
+  result.confidence = dacpo.getPointConfidence();
   result.flips = dacpo.getBlockFlips();
   result.edges = dacpo.getEdges();
   result.mesh_vertices = dacpo.getMeshVertices();
@@ -390,7 +394,8 @@ compute(const pcl::PCLPointCloud2& input,
   /* Keep every input field except the ones we write, then append ours. */
   pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(
       input,
-      {"normal_x", "normal_y", "normal_z", "curvature", "block", "component", "flip"});
+      {"normal_x", "normal_y", "normal_z", "curvature", "block", "component", "flip",
+       "confidence"});
   std::vector<float> values(4 * n);
   for (std::size_t i = 0; i < n; ++i) {
     values[4 * i] = normals_out[i].normal_x;
@@ -417,6 +422,8 @@ compute(const pcl::PCLPointCloud2& input,
     }
     const bool dense = output.is_dense;
     output = dacpo_tool::appendInt32Fields(output, kLabelFields, labels);
+    if (result.confidence.size() == n)
+      output = dacpo_tool::appendFloatFields(output, {"confidence"}, result.confidence);
     output.is_dense = dense;
   }
   return true;

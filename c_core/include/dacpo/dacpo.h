@@ -274,6 +274,13 @@ dacpo_ctx_stats(const dacpo_ctx* ctx);
  * - block: block id of the point.
  * - curvature: PCA surface variation lambda0/(l0+l1+l2) when normals were
  *   estimated, else NULL.
+ * - confidence: how sure the run is of the point's sign, in [0, 1]: the
+ *   product of (a) the share of stage-2 restarts that agree with it times the
+ *   margin of its last dipole decision (halved where stage 3 turned it over),
+ *   (b) how firmly the 0-1 program holds its block's flip, (c) the confidence
+ *   in its component's sign (1 with one component). Low values mark weak or
+ *   contradicted edges, blocks that disagree with themselves, restarts that
+ *   disagree and parts that could not be related.
  */
 DACPO_API const int32_t*
 dacpo_ctx_point_components(const dacpo_ctx* ctx);
@@ -281,6 +288,8 @@ DACPO_API const int32_t*
 dacpo_ctx_point_blocks(const dacpo_ctx* ctx);
 DACPO_API const float*
 dacpo_ctx_point_curvature(const dacpo_ctx* ctx);
+DACPO_API const float*
+dacpo_ctx_point_confidence(const dacpo_ctx* ctx);
 
 /**
  * \brief Scene mesh of the last successful run with params.keep_mesh = 1: the

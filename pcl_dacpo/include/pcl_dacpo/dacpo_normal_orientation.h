@@ -485,6 +485,17 @@ public:
     return component_labels_;
   }
 
+  /**
+   * \brief How sure the last compute() is of each output point's sign, in
+   * [0, 1] (see dacpo_ctx_point_confidence()); NaN for skipped points, empty
+   * after a failure. The least confident points hold most of the wrong ones.
+   */
+  const std::vector<float>&
+  getPointConfidence() const
+  {
+    return point_confidence_;
+  }
+
   /** \brief Block of each output point (as getComponentLabels()). */
   const std::vector<int>&
   getBlockLabels() const
@@ -574,6 +585,7 @@ private:
   std::string last_error_;
   dacpo_stats stats_;
   std::vector<int> component_labels_;
+  std::vector<float> point_confidence_;
   std::vector<int> block_labels_;
   std::vector<std::uint8_t> block_flips_;
   std::vector<dacpo_edge_info> edges_;

@@ -206,6 +206,7 @@ DACPONormalOrientation<PointInT, PointOutT>::fail(PointCloudOut& output,
   output.width = output.height = 0;
   output.clear();
   component_labels_.clear();
+  point_confidence_.clear();
   block_labels_.clear();
   block_flips_.clear();
   edges_.clear();
@@ -222,6 +223,7 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   last_error_.clear();
   std::memset(&stats_, 0, sizeof(stats_));
   component_labels_.clear();
+  point_confidence_.clear();
   block_labels_.clear();
   block_flips_.clear();
   edges_.clear();
@@ -366,7 +368,9 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   const float* curvature = dacpo_ctx_point_curvature(ctx.get());
   const std::int32_t* components = dacpo_ctx_point_components(ctx.get());
   const std::int32_t* blocks = dacpo_ctx_point_blocks(ctx.get());
+  const float* confidence = dacpo_ctx_point_confidence(ctx.get());
   component_labels_.assign(n_out, -1);
+  point_confidence_.assign(n_out, nan);
   block_labels_.assign(n_out, -1);
   for (std::size_t j = 0; j < m; ++j) {
     PointOutT& o = output[local_to_out[j]];
@@ -383,6 +387,8 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
       component_labels_[local_to_out[j]] = components[j];
     if (blocks)
       block_labels_[local_to_out[j]] = blocks[j];
+    if (confidence)
+      point_confidence_[local_to_out[j]] = confidence[j];
   }
   if (const std::uint8_t* flips = dacpo_ctx_block_flips(ctx.get()))
     block_flips_.assign(flips, flips + stats_.num_blocks);
