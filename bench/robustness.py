@@ -30,6 +30,9 @@ def parse():
     ap.add_argument("-w", dest="work", default=None, help="default: <build>/robustness")
     ap.add_argument("--label", default="default", help="name of this configuration")
     ap.add_argument("--args", default="", help="extra pcl_dacpo_orient arguments")
+    ap.add_argument("--peer", default=None,
+                    help="score a peer program instead (called as PEER in.ply out.ply ARGS, "
+                         "e.g. the benchmark's cgal_orient); no error split, seeds ignored")
     ap.add_argument("--seeds", default="1,2,3,4,5")
     ap.add_argument("--jobs", type=int, default=2, help="runs at once, one thread each")
     ap.add_argument("--force", action="store_true")
@@ -59,9 +62,13 @@ def run_one(opt, f, seed):
         with open(rec_path) as fh:
             return json.load(fh)
     tools = os.path.join(opt.build, "wrappers")
-    pred = os.path.join(d, f"{name}.s{seed}.pcd")
-    cmd = [os.path.join(tools, "pcl_dacpo_orient"), f, pred, "-estimate", "-labels",
-           "-seed", str(seed), "-threads", "1"] + opt.args.split()
+    if opt.peer:
+        pred = os.path.join(d, f"{name}.s{seed}.ply")
+        cmd = [opt.peer, f, pred] + opt.args.split()
+    else:
+        pred = os.path.join(d, f"{name}.s{seed}.pcd")
+        cmd = [os.path.join(tools, "pcl_dacpo_orient"), f, pred, "-estimate", "-labels",
+               "-seed", str(seed), "-threads", "1"] + opt.args.split()
     t0 = time.perf_counter()
     r = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True)
     wall = time.perf_counter() - t0
@@ -125,6 +132,8 @@ def main():
     opt = parse()
     opt.work = opt.work or os.path.join(opt.build, "robustness")
     seeds = [int(s) for s in opt.seeds.split(",") if s]
+    if opt.peer:
+        seeds = seeds[:1]
     groups = []
     for inp in opt.inputs:
         fs = files_of([inp])
@@ -141,7 +150,9 @@ def main():
                 if r["file"] == name and "error" in r:
                     print(f"robustness: {name} seed {r['seed']} failed: {r['error'][-300:]}", file=sys.stderr)
         groups.append((os.path.basename(os.path.normpath(inp)), rows))
-    md = table(f"{opt.label} ({'pcl_dacpo_orient -estimate ' + opt.args}, seeds {opt.seeds})", groups)
+    what = (os.path.basename(opt.peer) + " " + opt.args) if opt.peer else \
+        f"pcl_dacpo_orient -estimate {opt.args}, seeds {opt.seeds}"
+    md = table(f"{opt.label} ({what.strip()})", groups)
     print(md)
     if opt.md:
         with open(opt.md, "w") as fh:
