@@ -76,6 +76,7 @@ dacpo_params_init(dacpo_params* p)
   p->vcr_perspective = 0;
   p->vcr_boundary_factor = 1;
   p->dipole_restarts = 4;
+  p->weak_edge_fraction = 0.1;
 }
 
 static dacpo_status
@@ -122,6 +123,9 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (p->dipole_restarts < 1 || p->dipole_restarts > 64)
     return bad_field(message, size, "dipole_restarts must be in [1, 64] (got %zu)",
                      p->dipole_restarts);
+  if (!(p->weak_edge_fraction >= 0.0) || !(p->weak_edge_fraction <= 1.0))
+    return bad_field(message, size, "weak_edge_fraction must be in [0, 1] (got %g)",
+                     p->weak_edge_fraction);
   if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
     return bad_field(message, size, "dipole_final_sweep must be in [0, 1000] (got %d)",
                      p->dipole_final_sweep);

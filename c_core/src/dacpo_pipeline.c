@@ -10,7 +10,7 @@
  * normals are written only after everything succeeded. */
 #include "dacpo_block_graph.h"
 #include "dacpo_bridge.h"
-#include "dacpo_component_sign.h"
+#include "dacpo_part_sign.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
 #include "dacpo_ilp.h"
@@ -51,8 +51,9 @@ typedef struct run_state {
   double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;          /* per block */
   float* block_conf;       /* per block: how firmly stage 5 holds its flip */
-  int8_t* comp_sign;       /* per input component (VIEWPOINT policy) */
-  double* comp_conf;       /* per input component */
+  int32_t* part;           /* n: part of each point (VIEWPOINT policy) */
+  int8_t* part_sign;       /* per part */
+  double* part_conf;       /* per part */
   dacpo_ilp_result ilp;
 } run_state;
 
@@ -78,8 +79,9 @@ run_state_free(run_state* s)
   free(s->block_seconds);
   free(s->flips);
   free(s->block_conf);
-  free(s->comp_sign);
-  free(s->comp_conf);
+  free(s->part);
+  free(s->part_sign);
+  free(s->part_conf);
 }
 
 /* Calls the progress callback; non-zero means the caller asked to stop. */
@@ -326,14 +328,77 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 /* ---- relative sign of disconnected parts -------------------------------- */
 
+/* Parts whose sign the viewpoint vote decides: the blocks joined by block-graph
+ * edges that carry at least `weak` times the typical evidence (so never across
+ * components). With weak = 0 the parts are the k-NN components. */
 static dacpo_status
-relate_components(run_state* s, dacpo_stats* st, dacpo_err* err)
+label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
 {
-  const size_t n = s->cloud.n, nc = s->num_components;
-  s->comp_sign = dacpo_malloc_array(nc, sizeof(int8_t));
-  s->comp_conf = dacpo_malloc_array(nc, sizeof(double));
+  const size_t n = s->cloud.n, nb = s->blocks.num_blocks;
+  s->part = dacpo_malloc_array(n, sizeof(int32_t));
+  if (!s->part)
+    return DACPO_OOM(err);
+  if (!(weak > 0.0)) {
+    memcpy(s->part, s->input_component, n * sizeof(int32_t));
+    *num_parts = s->num_components;
+    return DACPO_OK;
+  }
+  int32_t* root = dacpo_malloc_array(nb, sizeof(int32_t));
+  int32_t* id = dacpo_malloc_array(nb, sizeof(int32_t));
+  if (!root || !id) {
+    free(root);
+    free(id);
+    return DACPO_OOM(err);
+  }
+  for (size_t b = 0; b < nb; ++b)
+    root[b] = (int32_t)b;
+  const double scale = dacpo_edge_evidence_scale(&s->bgraph);
+  for (size_t e = 0; e < s->bgraph.num_edges; ++e) {
+    const dacpo_block_edge* be = &s->bgraph.edges[e];
+    if (!(be->alpha + be->alpha_bar >= weak * scale))
+      continue;
+    int32_t a = be->a, b = be->b;
+    while (root[a] != a)
+      a = root[a] = root[root[a]];
+    while (root[b] != b)
+      b = root[b] = root[root[b]];
+    if (a != b)
+      root[a] = b;
+  }
+  size_t m = 0;
+  for (size_t b = 0; b < nb; ++b)
+    id[b] = -1;
+  for (size_t b = 0; b < nb; ++b) {
+    int32_t r = (int32_t)b;
+    while (root[r] != r)
+      r = root[r];
+    if (id[r] < 0)
+      id[r] = (int32_t)m++;
+    id[b] = id[r];
+  }
+  for (size_t i = 0; i < n; ++i)
+    s->part[i] = id[s->blocks.block_of[i]];
+  free(root);
+  free(id);
+  *num_parts = m;
+  return DACPO_OK;
+}
+
+/* Stage 5 decides the relative sign of blocks joined by edges with evidence;
+ * where the only evidence between two groups of blocks is weak (or there is
+ * none: separate components), each group takes the sign under which it faces
+ * the viewpoint the whole scene implies. */
+static dacpo_status
+relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  size_t np = 0;
+  DACPO_TRY(label_parts(s, s->p.weak_edge_fraction, &np, err));
+  st->num_parts = np;
+  s->part_sign = dacpo_malloc_array(np, sizeof(int8_t));
+  s->part_conf = dacpo_malloc_array(np, sizeof(double));
   double* final = dacpo_malloc_array(3 * n, sizeof(double));
-  if (!s->comp_sign || !s->comp_conf || !final) {
+  if (!s->part_sign || !s->part_conf || !final) {
     free(final);
     return DACPO_OOM(err);
   }
@@ -342,15 +407,14 @@ relate_components(run_state* s, dacpo_stats* st, dacpo_err* err)
     for (int d = 0; d < 3; ++d)
       final[3 * i + d] = f * s->oriented[3 * i + d];
   }
-  dacpo_status r = dacpo_component_signs(s->cloud.xyz, final, n, s->input_component, nc,
-                                         s->p.seed, s->comp_sign, s->comp_conf, &st->view_score,
-                                         err);
+  dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->p.seed,
+                                         s->part_sign, s->part_conf, &st->view_score, err);
   free(final);
-  /* the largest component has confidence 1 by definition; count the others */
+  /* the largest part has confidence 1 by definition; count the others */
   size_t related = 0;
-  for (size_t c = 0; c < nc; ++c)
-    related += s->comp_conf[c] > 0.0;
-  st->components_related = related > 0 ? related - 1 : 0;
+  for (size_t c = 0; c < np; ++c)
+    related += s->part_conf[c] > 0.0;
+  st->parts_related = related > 0 ? related - 1 : 0;
   return r;
 }
 
@@ -393,14 +457,14 @@ publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
   return DACPO_OK;
 }
 
-/* Confidence in the sign of point i's component relative to the largest one:
- * 1 with one component (or bridged into one), the viewpoint vote margin under
- * the VIEWPOINT policy, 0 for every part but the largest under SEPARATE. */
+/* Confidence in the sign of point i's part relative to the largest one: 1 with
+ * one component (or bridged into one), the viewpoint vote margin under the
+ * VIEWPOINT policy, 0 for every component but the largest under SEPARATE. */
 static double
 component_confidence(const run_state* s, size_t i)
 {
-  if (s->comp_conf)
-    return s->comp_conf[s->input_component[i]];
+  if (s->part_conf)
+    return s->part_conf[s->part[i]];
   if (s->num_components <= 1)
     return 1.0;
   return s->input_component[i] == s->largest_component_id ? 1.0 : 0.0;
@@ -457,8 +521,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     }
     double dot = axis[0] * o[0] + axis[1] * o[1] + axis[2] * o[2];
     double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip;
-    if (s->comp_sign)
-      sign *= (double)s->comp_sign[s->input_component[i]];
+    if (s->part_sign)
+      sign *= (double)s->part_sign[s->part[i]];
     for (int d = 0; d < 3; ++d)
       normals[3 * j + d] = (float)(sign * axis[d]);
     ctx->point_component[j] = s->input_component[i];
@@ -589,8 +653,9 @@ run(dacpo_ctx* ctx,
   STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
 
   DACPO_TRY(solve_flips(s, st, err));
-  if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT && s->num_components > 1)
-    DACPO_TRY(relate_components(s, st, err));
+  if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT &&
+      (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))
+    DACPO_TRY(relate_parts(s, st, err));
   STAGE_DONE(DACPO_STAGE_ILP);
 
   DACPO_TRY(publish(ctx, s, normals, err));

@@ -460,6 +460,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 0; }},
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 65; }},
       {"dipole_final_sweep", [](dacpo_params* p) { p->dipole_final_sweep = -1; }},
+      {"weak_edge_fraction", [](dacpo_params* p) { p->weak_edge_fraction = -0.5; }},
+      {"weak_edge_fraction", [](dacpo_params* p) { p->weak_edge_fraction = std::nan(""); }},
       {"normal_k",
        [](dacpo_params* p) {
          p->estimate_normals = 1;
@@ -716,7 +718,8 @@ TEST(DacpoInputErrors, DisconnectedPartsAreRelatedByDefault)
         << lastError(ctx.get());
     const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
     EXPECT_EQ(st->num_components, 2u);
-    EXPECT_EQ(st->components_related, 1u);
+    EXPECT_EQ(st->num_parts, 2u);
+    EXPECT_EQ(st->parts_related, 1u);
     EXPECT_GT(st->view_score, 0.99);
     for (size_t i = 1; i < out.size(); ++i)
       ASSERT_EQ(out.nrm[3 * i + 2], out.nrm[2]) << i;

@@ -142,6 +142,13 @@ printHelp(int, char** argv)
              "                                   (default: each part takes the sign that "
              "faces the viewpoint\n"
              "                                   implied by the largest part)\n");
+  print_info("                     -weak X     = block edges with less than X times the "
+             "typical evidence\n"
+             "                                   leave their blocks to the viewpoint vote, "
+             "0 = only\n"
+             "                                   disconnected parts (default: ");
+  print_value("%g", d.weak_edge_fraction);
+  print_info(")\n");
   print_info("                     -bridge     = join disconnected parts along their "
              "minimum spanning tree\n"
              "                                   and orient them as one\n");
@@ -628,7 +635,7 @@ parseOptions(int argc, char** argv, Options& o)
                 ring = o.params.ring_hops, seed = o.params.seed,
                 threads = o.params.num_threads, restarts = o.params.dipole_restarts;
   double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
-         band = o.params.dipole_noise_band;
+         band = o.params.dipole_noise_band, weak = o.params.weak_edge_fraction;
   if (!dacpo_tool::parseUnsigned(argc, argv, "-vcr_size", vcr_size, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-vcr_views", vcr_views, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
@@ -641,6 +648,7 @@ parseOptions(int argc, char** argv, Options& o)
       !dacpo_tool::parseUnsigned(argc, argv, "-threads", threads, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-c", c, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-band", band, error) ||
+      !dacpo_tool::parseDouble(argc, argv, "-weak", weak, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-time_limit", time_limit, error)) {
     print_error("Error: %s\n", error.c_str());
     return false;
@@ -660,6 +668,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.params.num_threads = static_cast<unsigned>(threads);
   o.params.dipole_c = c;
   o.params.dipole_noise_band = band;
+  o.params.weak_edge_fraction = weak;
   o.params.vcr_image_size = vcr_size;
   o.params.vcr_views = vcr_views;
   if (find_switch(argc, argv, "-vcr_perspective"))
@@ -788,7 +797,7 @@ main(int argc, char** argv)
       }));
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
-               "components=%zu components_related=%zu view_score=%.3f flipped=%zu "
+               "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "solver_optimal=%d ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
@@ -796,7 +805,8 @@ main(int argc, char** argv)
                s.num_block_edges,
                low,
                s.num_components,
-               s.components_related,
+               s.num_parts,
+               s.parts_related,
                s.view_score,
                s.flipped_blocks,
                s.solver_optimal ? 1 : 0,

@@ -101,11 +101,14 @@ typedef enum dacpo_disconnected_policy {
    *  tree (closest point pairs, plus a few nearby pairs per bridge) and orient
    *  the whole cloud as one; the bridges are counted in dacpo_stats. */
   DACPO_DISCONNECTED_BRIDGE = 2,
-  /** Orient every component on its own, then give each the sign under which
-   *  most of its points face the viewpoint that the largest (oriented)
-   *  component implies. Per-component vote margins are the confidences
-   *  (dacpo_ctx_component_confidence); when no viewpoint explains the largest
-   *  component the parts stay unrelated (confidence 0, as SEPARATE). */
+  /** Orient every component on its own; then cut the cloud into parts (the
+   *  components, split further where block-graph edges carry less than
+   *  weak_edge_fraction of the typical evidence), find the viewpoint that the
+   *  parts face best, each under its own sign, and give every part the sign
+   *  under which most of its points face it. The vote margins enter the
+   *  per-point confidence; when no viewpoint explains the scene (fewer than
+   *  75 % of the points facing it) the parts keep the signs stage 5 gave them
+   *  (components: undefined, as SEPARATE). */
   DACPO_DISCONNECTED_VIEWPOINT = 3
 } dacpo_disconnected_policy;
 
@@ -159,6 +162,10 @@ typedef struct dacpo_params {
   size_t dipole_restarts; /**< independent runs of stage 2 per block (M orders
                                each); the one with the highest block energy
                                (Eq. 4 summed over all pairs) is kept, 1..64 (4) */
+  double weak_edge_fraction; /**< VIEWPOINT policy: block-graph edges whose
+                                  alpha + alpha-bar is below this fraction of the
+                                  median edge's do not join blocks into one part;
+                                  0 = parts are the k-NN components (0.1) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -233,10 +240,13 @@ typedef struct dacpo_stats {
   size_t peak_block_points; /**< largest block incl. ring */
   size_t bridges_added;     /**< bridge edges added (DACPO_DISCONNECTED_BRIDGE) */
   double longest_bridge;    /**< length of the longest bridge edge */
-  double view_score;        /**< DACPO_DISCONNECTED_VIEWPOINT: share of the largest
-                                 component facing the inferred viewpoint (0 if unused) */
-  size_t components_related; /**< components other than the largest whose sign was
-                                  set by the viewpoint vote (confidence > 0) */
+  size_t num_parts;         /**< DACPO_DISCONNECTED_VIEWPOINT: parts whose sign the
+                                 viewpoint vote set (components, split further at
+                                 weak block edges); 0 if the vote did not run */
+  double view_score;        /**< share of the points that face the inferred viewpoint
+                                 under their part's sign (0 if unused) */
+  size_t parts_related;     /**< parts other than the largest whose sign the vote
+                                 set (confidence > 0) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -331,6 +331,22 @@ public:
     return params_.dipole_restarts;
   }
 
+  /** \brief Block-graph edges with less than this fraction of the median
+   *  edge's evidence leave the relative sign of the block groups they join to
+   *  the viewpoint vote (DACPO_DISCONNECTED_VIEWPOINT only; 0 = only
+   *  disconnected parts; default 0.1). */
+  void
+  setWeakEdgeFraction(double fraction)
+  {
+    params_.weak_edge_fraction = fraction;
+  }
+  /** \brief See setWeakEdgeFraction(). */
+  double
+  getWeakEdgeFraction() const
+  {
+    return params_.weak_edge_fraction;
+  }
+
   /** \brief What to do with a disconnected k-NN graph (default: relate the parts
    *  by the viewpoint the largest one implies, DACPO_DISCONNECTED_VIEWPOINT). */
   void

@@ -413,15 +413,17 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
              stats_.num_components,
              stats_.bridges_added,
              stats_.longest_bridge);
-  else if (stats_.num_components > 1 && params_.disconnected == DACPO_DISCONNECTED_VIEWPOINT)
+  else if (stats_.num_components > 1 && stats_.num_parts > 0)
     PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
-             "components (largest %zu points); %zu of the others were related to it by "
-             "the viewpoint it implies (score %.2f), the rest keep an undefined sign.\n",
+             "components (largest %zu points); the sign of %zu of %zu parts was set by "
+             "the viewpoint they imply (%.0f%% of the points face it), the rest keep "
+             "an undefined sign.\n",
              getClassName().c_str(),
              stats_.num_components,
              stats_.largest_component,
-             stats_.components_related,
-             stats_.view_score);
+             stats_.parts_related,
+             stats_.num_parts > 0 ? stats_.num_parts - 1 : 0,
+             100.0 * stats_.view_score);
   else if (stats_.num_components > 1)
     PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
              "components (largest %zu points); each is oriented on its own, their "

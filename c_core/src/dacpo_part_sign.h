@@ -1,0 +1,30 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Relative sign of parts (components, or block groups joined only by weak
+ * edges) from the viewpoint they imply (policy DACPO_DISCONNECTED_VIEWPOINT). */
+#ifndef DACPO_PART_SIGN_H
+#define DACPO_PART_SIGN_H
+
+#include "dacpo_internal.h"
+
+/* xyz, nrm: n points and their oriented normals (3n each); component[i] in
+ * [0, num_components) is the part of point i. Writes, per part, sign[c] in
+ * {+1, -1} (multiply the part's normals by it; the largest part keeps +1) and
+ * confidence[c] in [0, 1] (the vote margin |facing - not facing| / size; 1 for
+ * the largest part; 0 for all others when no viewpoint explains the scene,
+ * then every sign stays +1). *score_out (may be NULL) gets the share of a
+ * sample of the points that face the chosen viewpoint under their part's best
+ * sign. seed is unused (the result is the same for every seed).
+ * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
+dacpo_status
+dacpo_part_signs(const double* xyz,
+                      const double* nrm,
+                      size_t n,
+                      const int32_t* component,
+                      size_t num_components,
+                      uint64_t seed,
+                      int8_t* sign,
+                      double* confidence,
+                      double* score_out,
+                      dacpo_err* err);
+
+#endif
