@@ -384,6 +384,46 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* A part that weak edges join to others in its component keeps the relation
+ * stage 5 gave it to the component's largest part unless its own viewpoint vote
+ * is clear (margin >= DACPO_PART_MIN_MARGIN): weak evidence is still evidence,
+ * a near tie of the vote is not. The component's largest part follows the vote
+ * (it has no other relation to the rest of the scene). */
+#define DACPO_PART_MIN_MARGIN 0.3
+
+static dacpo_status
+keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  size_t* size = dacpo_calloc_array(np, sizeof(size_t));
+  int32_t* comp = dacpo_malloc_array(np, sizeof(int32_t));
+  int32_t* anchor = dacpo_malloc_array(s->num_components, sizeof(int32_t));
+  if (!size || !comp || !anchor) {
+    free(size);
+    free(comp);
+    free(anchor);
+    return DACPO_OOM(err);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    size[s->part[i]]++;
+    comp[s->part[i]] = s->input_component[i];
+  }
+  for (size_t c = 0; c < s->num_components; ++c)
+    anchor[c] = -1;
+  for (size_t q = 0; q < np; ++q)
+    if (size[q] > 0 && (anchor[comp[q]] < 0 || size[q] > size[anchor[comp[q]]]))
+      anchor[comp[q]] = (int32_t)q;
+  for (size_t q = 0; q < np; ++q) {
+    const int32_t a = size[q] > 0 ? anchor[comp[q]] : (int32_t)q;
+    if (a != (int32_t)q && s->part_conf[q] < DACPO_PART_MIN_MARGIN)
+      s->part_sign[q] = s->part_sign[a];
+  }
+  free(size);
+  free(comp);
+  free(anchor);
+  return DACPO_OK;
+}
+
 /* Stage 5 decides the relative sign of blocks joined by edges with evidence;
  * where the only evidence between two groups of blocks is weak (or there is
  * none: separate components), each group takes the sign under which it faces
@@ -410,6 +450,8 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
   dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->p.seed,
                                          s->part_sign, s->part_conf, &st->view_score, err);
   free(final);
+  if (r == DACPO_OK && np > s->num_components)
+    r = keep_weak_evidence(s, np, err);
   /* the largest part has confidence 1 by definition; count the others */
   size_t related = 0;
   for (size_t c = 0; c < np; ++c)
