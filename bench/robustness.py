@@ -30,6 +30,9 @@ def parse():
     ap.add_argument("-w", dest="work", default=None, help="default: <build>/robustness")
     ap.add_argument("--label", default="default", help="name of this configuration")
     ap.add_argument("--args", default="", help="extra pcl_dacpo_orient arguments")
+    ap.add_argument("--block-factor", type=float, default=None,
+                    help="run with -blocks = factor x the automatic count (n/2500 in [1, 200]): "
+                         "sensitivity to the block count")
     ap.add_argument("--peer", default=None,
                     help="score a peer program instead (called as PEER in.ply out.ply ARGS, "
                          "e.g. the benchmark's cgal_orient); no error split, seeds ignored")
@@ -53,6 +56,17 @@ def files_of(inputs):
     return out
 
 
+def ply_vertices(path):
+    with open(path, "rb") as fh:
+        for _ in range(200):
+            line = fh.readline().decode("ascii", "replace").strip()
+            if line.startswith("element vertex"):
+                return int(line.split()[-1])
+            if line == "end_header":
+                break
+    return 0
+
+
 def run_one(opt, f, seed):
     name = os.path.splitext(os.path.basename(f))[0]
     d = os.path.join(opt.work, "runs", opt.label)
@@ -69,6 +83,9 @@ def run_one(opt, f, seed):
         pred = os.path.join(d, f"{name}.s{seed}.pcd")
         cmd = [os.path.join(tools, "pcl_dacpo_orient"), f, pred, "-estimate", "-labels",
                "-seed", str(seed), "-threads", "1"] + opt.args.split()
+        if opt.block_factor:
+            auto = min(200, max(1, ply_vertices(f) // 2500))
+            cmd += ["-blocks", str(max(1, round(auto * opt.block_factor)))]
     t0 = time.perf_counter()
     r = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True)
     wall = time.perf_counter() - t0
@@ -89,6 +106,8 @@ def run_one(opt, f, seed):
                        comp_best=ev.get("component_wrong_pct", ev["wrong_pct"]),
                        in_block=ev.get("intra_block_wrong_pct", ev["wrong_pct"]),
                        blocks=ev.get("blocks", 0), components=ev["components"])
+            if "wrong_in_least_confident10_pct" in ev:
+                rec["wrong_in_low_conf10"] = ev["wrong_in_least_confident10_pct"]
             rec["flip"] = rec["comp_best"] - rec["in_block"]
             rec["component"] = rec["wrong"] - rec["comp_best"]
         os.remove(pred)
@@ -108,6 +127,8 @@ def summarize(recs):
                 best=ok[0]["wrong"], spread=ok[-1]["wrong"] - ok[0]["wrong"],
                 in_block=med["in_block"], flip=med["flip"], component=med["component"],
                 wall_s=statistics.median(r["wall_s"] for r in ok),
+                low_conf10=(statistics.median(r["wrong_in_low_conf10"] for r in ok)
+                            if all("wrong_in_low_conf10" in r for r in ok) else None),
                 per_seed={str(r["seed"]): round(r["wrong"], 3) for r in ok})
 
 
