@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Bridges between the components of a disconnected k-NN graph (an optional
- * policy; ALGORITHM.md §1 "disconnected input": components have no defined
- * relative orientation, so joining them is a choice the caller reports).
+ * policy: components have no defined relative orientation, so joining them
+ * is a choice the caller reports).
  *
  * Single-view depth scans break into several components at depth
  * discontinuities. To orient the cloud as one, the components are joined by a

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Optional policy for a disconnected k-NN graph: join the components with
- * bridge edges so the whole cloud is oriented as one (ALGORITHM.md §1,
- * "disconnected input"; never silent: the caller reports the counts). */
+ * bridge edges so the whole cloud is oriented as one (never silent: the
+ * caller reports the counts). */
 #ifndef DACPO_BRIDGE_H
 #define DACPO_BRIDGE_H
 

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * Stage 2: orientation initialisation of one block by a dipole-like field and a
- * randomized greedy propagation (paper §4.2, Eq. 1-4; ALGORITHM.md §2).
+ * randomized greedy propagation (paper §4.2, Eq. 1-4).
  *
  * Input:  n points of one block (xyz, unit normal axes nrm, 3n doubles each) and
  *         dacpo_dipole_params (c, M orders, K neighbours, BFS graph k, seed, stream).

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
- * Stage 5: the 0-1 block-flip program (paper §5.2, Eq. 8; ALGORITHM.md §5).
+ * Stage 5: the 0-1 block-flip program (paper §5.2, Eq. 8).
  *
  * Every block i gets a flip o_i in {0,1}; Eq. 8 maximizes
  *   sum_{(i,j) in E} omega_ij(o_i, o_j),
@@ -20,8 +20,8 @@
  *      edges can all be satisfied at once; those never reach lp_solve;
  *   4. every other component goes to lp_solve: binary o_i and y_e, all four XOR
  *      inequalities per edge, and the triangle inequalities of every 3-cycle
- *      (y_ab <= y_ac + y_bc and rotations, y_ab + y_ac + y_bc <= 2). ALGORITHM.md
- *      §5 measured that the XOR rows alone leave lp_solve slow and far from the
+ *      (y_ab <= y_ac + y_bc and rotations, y_ab + y_ac + y_bc <= 2). Measured
+ *      here: the XOR rows alone leave lp_solve slow and far from the
  *      optimum, while the triangle rows make the relaxation nearly integral.
  *      Where the relaxation is still fractional, violated odd-cycle inequalities
  *      (found by shortest paths in the doubled "parity" graph, Barahona &
@@ -775,8 +775,8 @@ typedef struct ilp_lp_ws {
   int* col;
 } ilp_lp_ws;
 
-/* Adds one row. add_constraintex may reorder the arrays it is given
- * (ALGORITHM.md §5), so the caller refills them before every call. */
+/* Adds one row. add_constraintex may reorder the arrays it is given, so the
+ * caller refills them before every call. */
 static int
 ilp_add_row(lprec* lp, int count, double* row, int* col, int type, double rhs, size_t* rows)
 {

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Stage 0, input (ALGORITHM.md §0, STYLE.md §4): validate the caller's arrays and
+/* Stage 0, input: validate the caller's arrays and
  * merge exact duplicates.
  *
  * The dipole field of paper Eq. 1 divides by |r|^3, so coincident points must not

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Input checks and duplicate merging (ALGORITHM.md §0). */
+/* Input checks and duplicate merging. */
 #ifndef DACPO_INPUT_H
 #define DACPO_INPUT_H
 

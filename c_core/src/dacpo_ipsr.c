@@ -1,7 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 3b: iterative Poisson surface reconstruction (iPSR, Hou et al. 2022)
- * with Neumann boundary conditions, one block at a time (paper §4.3,
- * ALGORITHM.md §3).
+ * with Neumann boundary conditions, one block at a time (paper §4.3).
  *
  * Input: a block's n samples (own points first, then the ring) and their
  * initial oriented normals (stage 2). Output: refined normals (in place), and

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 3: iPSR with a Neumann screened Poisson solver, one block at a time
- * (paper §4.3, ALGORITHM.md §3). Implemented in dacpo_ipsr.c on top of
+ * (paper §4.3). Implemented in dacpo_ipsr.c on top of
  * dacpo_poisson.h (solver) and dacpo_mcubes.h (iso-surface). */
 #ifndef DACPO_IPSR_H
 #define DACPO_IPSR_H

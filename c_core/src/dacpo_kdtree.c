@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Built-in exact k-nearest-neighbour search in 3-D (stage 0 of the pipeline,
- * ALGORITHM.md §0: "the core also has its own search so it runs and tests
- * without PCL"; also used by later stages on block-local point sets).
+ * the core has its own search so it runs and tests
+ * without PCL; also used by later stages on block-local point sets).
  *
  * Input:  n points (3n doubles, copied). Output: a read-only tree.
  * Layout: the points are permuted into tree order (leaves are contiguous runs)

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Stage 0, neighbours (ALGORITHM.md §0; the k-NN graph the paper's §4.1
+/* Stage 0, neighbours (the k-NN graph the paper's §4.1
  * segmentation and §4.2 propagation run on).
  *
  * dacpo_knn_build: the k nearest DISTINCT neighbours of every distinct point.
@@ -13,8 +13,8 @@
  *   Failures: callback non-zero / bad index / too many results
  *   (NEIGHBOR_SEARCH, naming the query's input index), cancel (CANCELLED),
  *   allocation (OUT_OF_MEMORY).
- * dacpo_adjacency_build: symmetric CSR (i~j if either lists the other), as
- *   ALGORITHM.md §0 asks; O(n k) memory and time (plus row sorts).
+ * dacpo_adjacency_build: symmetric CSR (i~j if either lists the other);
+ *   O(n k) memory and time (plus row sorts).
  * dacpo_components_label: BFS, labels in order of each component's lowest
  *   point index; O(n + edges). */
 #include "dacpo_knn.h"

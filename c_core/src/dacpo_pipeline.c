@@ -186,7 +186,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     st = DACPO_OOM(err);
     goto done;
   }
-  /* own points first, then the ring (ALGORITHM.md §1: the ring gives
+  /* own points first, then the ring (the ring gives
    * continuity to propagation and Poisson but is not part of the output) */
   for (size_t i = 0; i < n; ++i) {
     int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
@@ -585,7 +585,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 static size_t
 auto_blocks(size_t n)
 {
-  /* ALGORITHM.md §1: about 2.5K points per block, at most the paper's 200. */
+  /* about 2.5K points per block, at most the paper's 200. */
   size_t b = n / 2500;
   if (b < 1)
     b = 1;

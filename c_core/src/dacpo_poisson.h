@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 3a: screened Poisson indicator with Neumann boundary on a block's box
- * (paper §4.3, Kazhdan & Hoppe 2013; ALGORITHM.md §3). Set up once per block
+ * (paper §4.3, Kazhdan & Hoppe 2013). Set up once per block
  * (grid, narrow-band domain, multigrid hierarchy, screening stencils), then
  * solved many times from different normals with a warm start: the points never
  * move in iPSR. */

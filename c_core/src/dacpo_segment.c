@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
- * Stage 1: block segmentation (paper §4.1, ALGORITHM.md §1).
+ * Stage 1: block segmentation (paper §4.1).
  *
  * The paper cuts the cloud into about 200 spatially connected blocks, each small
  * enough for the local dipole/iPSR stages and large enough to carry a reliable
@@ -15,7 +15,7 @@
  *   4. one multi-source BFS over the k-NN adjacency, started from all seeds at
  *      once, gives every point the block whose frontier reaches it first, so each
  *      block is connected in the graph by construction (O(n + E));
- *   5. the overlap ring of a block (ALGORITHM.md §1, used by iPSR for continuity)
+ *   5. the overlap ring of a block (used by iPSR for continuity)
  *      is every point of another block within ring_hops hops of it, found by a
  *      depth-limited BFS per block with a shared visit stamp array (stamp = block
  *      id), so no n-array is cleared per block: O(E + sum ring * degree).

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Stage 1: block segmentation (paper §4.1, ALGORITHM.md §1). */
+/* Stage 1: block segmentation (paper §4.1). */
 #ifndef DACPO_SEGMENT_H
 #define DACPO_SEGMENT_H
 

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 4b: visible connected regions (VCR) between two adjacent blocks
  * (paper §5.1 "Visible Connected Regions" and "Orientation Consistency
- * Evaluation", Eq. 6-7; ALGORITHM.md §4).
+ * Evaluation", Eq. 6-7).
  *
  * In:  the trimmed meshes a and b of two adjacent blocks (face normal
  *      (v1-v0)x(v2-v0) agrees with the block's oriented normals), parameters.

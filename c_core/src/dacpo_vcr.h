@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Stage 4b: visible connected regions between two adjacent blocks' meshes
- * (paper §5.1, ALGORITHM.md §4). */
+ * (paper §5.1). */
 #ifndef DACPO_VCR_H
 #define DACPO_VCR_H
 

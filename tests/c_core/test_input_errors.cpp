@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The bad-input table of STYLE.md section 4, through the public C API only
+// The bad-input table of the README, through the public C API only
 // (dacpo_orient, dacpo_params_init/validate, dacpo_ctx_*): one test per row.
 // Every failing call is checked for the exact status, a message that names the
 // problem (the bad index or field), a caller's normals buffer left byte for byte
