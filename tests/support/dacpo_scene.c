@@ -1049,3 +1049,67 @@ dacpo_score_oriented(const float* gt,
     *wrong_out = wrong;
   return 100.0 * (double)wrong / (double)n;
 }
+
+/* ------------------------------------------------------------------------- */
+/* Two parallel sheets facing away from each other (thin-structure tests).    */
+
+int
+dacpo_scene_parallel_sheets(double size,
+                            double spacing,
+                            double gap,
+                            double sigma,
+                            uint64_t seed,
+                            dacpo_scene* out,
+                            char* err,
+                            size_t errlen)
+{
+  if (!out || !(size > 0.0) || !(spacing > 0.0) || !(gap > 0.0) || !(sigma >= 0.0) ||
+      size / spacing > 2000.0) {
+    if (err && errlen)
+      snprintf(err, errlen, "parallel sheets: bad argument");
+    return -1;
+  }
+  memset(out, 0, sizeof(*out));
+  const size_t m = (size_t)(size / spacing) + 1, n = 2 * m * m;
+  out->xyz = malloc(3 * n * sizeof(float));
+  out->normals = malloc(3 * n * sizeof(float));
+  out->part = malloc(n * sizeof(int32_t));
+  out->part_object = malloc(2 * sizeof(int32_t));
+  out->object_name = malloc(sizeof(const char*));
+  if (!out->xyz || !out->normals || !out->part || !out->part_object || !out->object_name) {
+    dacpo_scene_free(out);
+    if (err && errlen)
+      snprintf(err, errlen, "parallel sheets: out of memory");
+    return -1;
+  }
+  scene_rng r;
+  rng_init(&r, seed, 17);
+  size_t k = 0;
+  for (int sheet = 0; sheet < 2; ++sheet)
+    for (size_t a = 0; a < m; ++a)
+      for (size_t b = 0; b < m; ++b, ++k) {
+        /* jittered grid, so the two sheets' points do not sit exactly above
+         * each other; the lower sheet faces -z, the upper +z */
+        double p[3] = {((double)a + 0.5 * (rng_uniform(&r) - 0.5)) * spacing,
+                       ((double)b + 0.5 * (rng_uniform(&r) - 0.5)) * spacing,
+                       sheet ? gap : 0.0};
+        if (sigma > 0.0) {
+          double d[3];
+          const double g = sigma * rng_gauss(&r);
+          rng_unit_vector(&r, d);
+          for (int c = 0; c < 3; ++c)
+            p[c] += g * d[c];
+        }
+        for (int c = 0; c < 3; ++c) {
+          out->xyz[3 * k + c] = (float)p[c];
+          out->normals[3 * k + c] = c == 2 ? (sheet ? 1.0f : -1.0f) : 0.0f;
+        }
+        out->part[k] = sheet;
+      }
+  out->n = n;
+  out->num_parts = 2;
+  out->part_object[0] = out->part_object[1] = 0;
+  out->num_objects = 1;
+  out->object_name[0] = "board";
+  return 0;
+}

@@ -164,6 +164,22 @@ dacpo_score_oriented(const float* gt,
                      const int32_t* component,
                      size_t* wrong_out);
 
+/**
+ * \brief Two square sheets of side \a size, \a gap apart along z and facing away
+ * from each other (lower -z, upper +z): a thin board without its rim. Points on
+ * a jittered grid of \a spacing, moved by Gaussian noise of \a sigma along
+ * random directions. Returns 0, or -1 with a message.
+ */
+int
+dacpo_scene_parallel_sheets(double size,
+                            double spacing,
+                            double gap,
+                            double sigma,
+                            uint64_t seed,
+                            dacpo_scene* out,
+                            char* err,
+                            size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif
