@@ -7,11 +7,11 @@
  * decided by the paper's method. Nor is it, in practice, between two groups of
  * blocks that only a weak block-graph edge joins (a contact of a few pixels):
  * measured on real depth frames, such edges decided whole groups wrongly with
- * full Eq. 7 confidence. The pipeline hands both kinds of part to this step. Scans are seen from somewhere: every surface
- * point faces the free space it was observed from, so there is a viewpoint v
- * with n_i . (v - p_i) > 0 for most points of every part once each part has
- * its right sign (a sensor position for a single depth frame, the inside of an
- * open room for a fused scan). Each part is consistent on its own, so v is the
+ * full Eq. 7 confidence. The pipeline hands both kinds of part to this step. Scans are
+ * seen from somewhere: every surface point faces the free space it was observed from,
+ * so there is a viewpoint v with n_i . (v - p_i) > 0 for most points of every part once
+ * each part has its right sign (a sensor position for a single depth frame, the inside
+ * of an open room for a fused scan). Each part is consistent on its own, so v is the
  * point that explains the parts best when each may still flip: score(v) =
  * sum over parts of |facing - not facing| / sample size. Every part then takes
  * the sign under which most of its points face v, relative to the largest
@@ -24,7 +24,7 @@
  * (e.g. closed objects with outward normals) and they are left unrelated
  * (confidence 0), as with the SEPARATE policy: reported, not guessed.
  * Measured (15 real depth frames and 18 synthetic rooms, seeds 1-5, median):
- * the component-sign part of the error fell from 4.29 % to 0.27 % (frames)
+ * the part-sign share of the error fell from 4.29 % to 0.18 % (frames)
  * and from 0.39 % to 0.07 % (rooms).
  *
  * Cost: O(candidates x sample + n). Deterministic for a seed.
@@ -47,10 +47,16 @@ enum { DACPO_VIEW_SAMPLE = 4096, DACPO_VIEW_CANDIDATES = 1024 };
  * part faces v under its part's best sign). *mean_dist gets the mean distance
  * from v to the sample points. */
 static double
-view_score(const double* sp, const double* sn, const int32_t* sc, size_t m, const double v[3],
-           double* vote, size_t num_components, double* mean_dist)
+view_score(const double* sp,
+           const double* sn,
+           const int32_t* sc,
+           size_t m,
+           const double v[3],
+           double* vote,
+           size_t num_parts,
+           double* mean_dist)
 {
-  memset(vote, 0, num_components * sizeof(double));
+  memset(vote, 0, num_parts * sizeof(double));
   double dist = 0.0;
   for (size_t s = 0; s < m; ++s) {
     const double* p = sp + 3 * s;
@@ -61,7 +67,7 @@ view_score(const double* sp, const double* sn, const int32_t* sc, size_t m, cons
     dist += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   }
   double total = 0.0;
-  for (size_t c = 0; c < num_components; ++c)
+  for (size_t c = 0; c < num_parts; ++c)
     total += fabs(vote[c]);
   *mean_dist = m ? dist / (double)m : 0.0;
   return m ? total / (double)m : 0.0;
@@ -69,29 +75,31 @@ view_score(const double* sp, const double* sn, const int32_t* sc, size_t m, cons
 
 dacpo_status
 dacpo_part_signs(const double* xyz,
-                      const double* nrm,
-                      size_t n,
-                      const int32_t* component,
-                      size_t num_components,
-                      uint64_t seed,
-                      int8_t* sign,
-                      double* confidence,
-                      double* score_out,
-                      dacpo_err* err)
+                 const double* nrm,
+                 size_t n,
+                 const int32_t* part,
+                 size_t num_parts,
+                 uint64_t seed,
+                 int8_t* sign,
+                 double* confidence,
+                 double* score_out,
+                 dacpo_err* err)
 {
-  DACPO_CHECK(err, xyz && nrm && component && sign && confidence, DACPO_ERR_INVALID_ARGUMENT,
-              "component signs: NULL argument");
-  for (size_t c = 0; c < num_components; ++c) {
+  DACPO_CHECK(err,
+              xyz && nrm && part && sign && confidence,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "part signs: NULL argument");
+  for (size_t c = 0; c < num_parts; ++c) {
     sign[c] = 1;
-    confidence[c] = c == 0 && num_components == 1 ? 1.0 : 0.0;
+    confidence[c] = c == 0 && num_parts == 1 ? 1.0 : 0.0;
   }
   if (score_out)
     *score_out = 0.0;
-  if (num_components <= 1 || n == 0)
+  if (num_parts <= 1 || n == 0)
     return DACPO_OK;
 
-  size_t* size = dacpo_calloc_array(num_components, sizeof(size_t));
-  double* vote = dacpo_calloc_array(num_components, sizeof(double));
+  size_t* size = dacpo_calloc_array(num_parts, sizeof(size_t));
+  double* vote = dacpo_calloc_array(num_parts, sizeof(double));
   double* sp = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
   double* sn = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
   int32_t* sc = dacpo_malloc_array(DACPO_VIEW_SAMPLE, sizeof(int32_t));
@@ -104,16 +112,18 @@ dacpo_part_signs(const double* xyz,
     return DACPO_OOM(err);
   }
   for (size_t i = 0; i < n; ++i)
-    size[component[i]]++;
+    size[part[i]]++;
   size_t big = 0;
-  for (size_t c = 1; c < num_components; ++c)
+  for (size_t c = 1; c < num_parts; ++c)
     if (size[c] > size[big])
       big = c;
 
   /* Evenly strided sample of the whole cloud and its bounding box. */
-  const size_t stride = n > DACPO_VIEW_SAMPLE ? (n + DACPO_VIEW_SAMPLE - 1) / DACPO_VIEW_SAMPLE : 1;
+  const size_t stride =
+      n > DACPO_VIEW_SAMPLE ? (n + DACPO_VIEW_SAMPLE - 1) / DACPO_VIEW_SAMPLE : 1;
   size_t m = 0;
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (size_t i = 0; i < n; ++i) {
     for (int d = 0; d < 3; ++d) {
       lo[d] = fmin(lo[d], xyz[3 * i + d]);
@@ -122,20 +132,21 @@ dacpo_part_signs(const double* xyz,
     if (i % stride == 0 && m < DACPO_VIEW_SAMPLE) {
       memcpy(sp + 3 * m, xyz + 3 * i, 3 * sizeof(double));
       memcpy(sn + 3 * m, nrm + 3 * i, 3 * sizeof(double));
-      sc[m++] = component[i];
+      sc[m++] = part[i];
     }
   }
-  const double diam = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double diam =
+      sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+           (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
   /* Candidates: sample points pushed along either side of their normal (a
-   * component's sign is not known yet) by 1/4 .. 2 scene diameters. */
+   * part's sign is not known yet) by 1/4 .. 2 scene diameters. */
   static const double push[4] = {0.25, 0.5, 1.0, 2.0};
   /* The candidates do not depend on the run's seed: the parts' relation is a
    * property of the scene, every seed should find the same one. Two stacked
    * parts (a table top over the floor) are explained as well by a viewpoint
    * above both as by one between them that the upper part hides; among
-   * candidates that explain the sample equally well (within 0.2 %) the one
+   * candidates that explain the sample equally well (within 0.05 %) the one
    * farther from the points is kept, since a sensor stands back from what it
    * scans. */
   (void)seed;
@@ -145,11 +156,13 @@ dacpo_part_signs(const double* xyz,
   for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && m > 0; ++k) {
     const size_t j = dacpo_rng_below(&rng, m);
     const double t = (k & 4u ? -1.0 : 1.0) * push[k % 4] * diam;
-    const double v[3] = {sp[3 * j] + t * sn[3 * j], sp[3 * j + 1] + t * sn[3 * j + 1],
+    const double v[3] = {sp[3 * j] + t * sn[3 * j],
+                         sp[3 * j + 1] + t * sn[3 * j + 1],
                          sp[3 * j + 2] + t * sn[3 * j + 2]};
     double dist;
-    const double score = view_score(sp, sn, sc, m, v, vote, num_components, &dist);
-    if (score > facing + DACPO_VIEW_TIE || (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
+    const double score = view_score(sp, sn, sc, m, v, vote, num_parts, &dist);
+    if (score > facing + DACPO_VIEW_TIE ||
+        (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
       facing = fmax(score, facing);
       best_dist = dist;
       memcpy(best_v, v, sizeof(best_v));
@@ -158,18 +171,18 @@ dacpo_part_signs(const double* xyz,
   if (score_out)
     *score_out = facing;
   if (facing >= DACPO_VIEW_MIN_SCORE) {
-    /* Every point votes; the largest component keeps its sign (the others
+    /* Every point votes; the largest part keeps its sign (the others
      * follow it), so flip the votes when the largest one does not face v. */
-    memset(vote, 0, num_components * sizeof(double));
+    memset(vote, 0, num_parts * sizeof(double));
     for (size_t i = 0; i < n; ++i) {
       const double* p = xyz + 3 * i;
       const double* q = nrm + 3 * i;
-      const double f =
-          q[0] * (best_v[0] - p[0]) + q[1] * (best_v[1] - p[1]) + q[2] * (best_v[2] - p[2]);
-      vote[component[i]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
+      const double f = q[0] * (best_v[0] - p[0]) + q[1] * (best_v[1] - p[1]) +
+                       q[2] * (best_v[2] - p[2]);
+      vote[part[i]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
     }
     const double ref = vote[big] < 0.0 ? -1.0 : 1.0;
-    for (size_t c = 0; c < num_components; ++c) {
+    for (size_t c = 0; c < num_parts; ++c) {
       if (size[c] == 0)
         continue;
       sign[c] = vote[c] * ref < 0.0 ? -1 : 1;

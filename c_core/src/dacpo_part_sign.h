@@ -6,8 +6,8 @@
 
 #include "dacpo_internal.h"
 
-/* xyz, nrm: n points and their oriented normals (3n each); component[i] in
- * [0, num_components) is the part of point i. Writes, per part, sign[c] in
+/* xyz, nrm: n points and their oriented normals (3n each); part[i] in
+ * [0, num_parts) is the part of point i. Writes, per part, sign[c] in
  * {+1, -1} (multiply the part's normals by it; the largest part keeps +1) and
  * confidence[c] in [0, 1] (the vote margin |facing - not facing| / size; 1 for
  * the largest part; 0 for all others when no viewpoint explains the scene,
@@ -17,14 +17,14 @@
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_part_signs(const double* xyz,
-                      const double* nrm,
-                      size_t n,
-                      const int32_t* component,
-                      size_t num_components,
-                      uint64_t seed,
-                      int8_t* sign,
-                      double* confidence,
-                      double* score_out,
-                      dacpo_err* err);
+                 const double* nrm,
+                 size_t n,
+                 const int32_t* part,
+                 size_t num_parts,
+                 uint64_t seed,
+                 int8_t* sign,
+                 double* confidence,
+                 double* score_out,
+                 dacpo_err* err);
 
 #endif
