@@ -76,7 +76,7 @@ dacpo_params_init(dacpo_params* p)
   p->vcr_perspective = 0;
   p->vcr_boundary_factor = 1;
   p->dipole_restarts = 4;
-  p->weak_edge_fraction = 0.1;
+  p->weak_edge_fraction = 1.0;
 }
 
 static dacpo_status

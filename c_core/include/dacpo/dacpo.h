@@ -165,7 +165,10 @@ typedef struct dacpo_params {
   double weak_edge_fraction; /**< VIEWPOINT policy: block-graph edges whose
                                   alpha + alpha-bar is below this fraction of the
                                   median edge's do not join blocks into one part;
-                                  0 = parts are the k-NN components (0.1) */
+                                  0 = parts are the k-NN components (1: every
+                                  edge below the median; measured on 15 real
+                                  frames x 5 seeds: worst seed 8.55 % -> 5.75 %
+                                  against 0.1, rooms unchanged) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -334,7 +334,8 @@ public:
   /** \brief Block-graph edges with less than this fraction of the median
    *  edge's evidence leave the relative sign of the block groups they join to
    *  the viewpoint vote (DACPO_DISCONNECTED_VIEWPOINT only; 0 = only
-   *  disconnected parts; default 0.1). */
+   *  disconnected parts; default 1: every edge below the median). A part
+   *  follows the vote only when its margin is >= 0.3. */
   void
   setWeakEdgeFraction(double fraction)
   {
