@@ -415,8 +415,12 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
       anchor[comp[q]] = (int32_t)q;
   for (size_t q = 0; q < np; ++q) {
     const int32_t a = size[q] > 0 ? anchor[comp[q]] : (int32_t)q;
-    if (a != (int32_t)q && s->part_conf[q] < DACPO_PART_MIN_MARGIN)
+    if (a != (int32_t)q && s->part_conf[q] < DACPO_PART_MIN_MARGIN) {
+      /* stage 5 holds it to the anchor: the block confidence speaks for
+       * that relation, the anchor's vote for the rest */
       s->part_sign[q] = s->part_sign[a];
+      s->part_conf[q] = s->part_conf[a];
+    }
   }
   free(size);
   free(comp);
