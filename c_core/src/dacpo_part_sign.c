@@ -27,7 +27,7 @@
  * the part-sign share of the error fell from 4.29 % to 0.18 % (frames)
  * and from 0.39 % to 0.07 % (rooms).
  *
- * Cost: O(candidates x sample + n). Deterministic for a seed.
+ * Cost: O(candidates x sample + n). Deterministic, the same for every seed.
  */
 #include "dacpo_part_sign.h"
 
@@ -79,7 +79,6 @@ dacpo_part_signs(const double* xyz,
                  size_t n,
                  const int32_t* part,
                  size_t num_parts,
-                 uint64_t seed,
                  int8_t* sign,
                  double* confidence,
                  double* score_out,
@@ -149,7 +148,6 @@ dacpo_part_signs(const double* xyz,
    * candidates that explain the sample equally well (within 0.05 %) the one
    * farther from the points is kept, since a sensor stands back from what it
    * scans. */
-  (void)seed;
   dacpo_rng rng;
   dacpo_rng_seed(&rng, 0x7669657770ull /* "viewp" */, 0);
   double best_v[3] = {0.0, 0.0, 0.0}, facing = -1.0, best_dist = 0.0;

@@ -13,7 +13,7 @@
  * the largest part; 0 for all others when no viewpoint explains the scene,
  * then every sign stays +1). *score_out (may be NULL) gets the share of a
  * sample of the points that face the chosen viewpoint under their part's best
- * sign. seed is unused (the result is the same for every seed).
+ * sign. The result does not depend on the run's seed.
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_part_signs(const double* xyz,
@@ -21,7 +21,6 @@ dacpo_part_signs(const double* xyz,
                  size_t n,
                  const int32_t* part,
                  size_t num_parts,
-                 uint64_t seed,
                  int8_t* sign,
                  double* confidence,
                  double* score_out,

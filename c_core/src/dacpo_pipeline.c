@@ -51,6 +51,7 @@ typedef struct run_state {
   double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;          /* per block */
   float* block_conf;       /* per block: how firmly stage 5 holds its flip */
+  double evidence_scale;   /* median alpha + alpha-bar of the block edges (stage 5) */
   int32_t* part;           /* n: part of each point (VIEWPOINT policy) */
   int8_t* part_sign;       /* per part */
   double* part_conf;       /* per part */
@@ -309,12 +310,13 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
     free(ie);
     return DACPO_OOM(err);
   }
-  const double scale = dacpo_edge_evidence_scale(&s->bgraph);
+  s->evidence_scale = dacpo_edge_evidence_scale(&s->bgraph);
   for (size_t e = 0; e < ne; ++e) {
     const dacpo_block_edge* be = &s->bgraph.edges[e];
     ie[e].a = be->a;
     ie[e].b = be->b;
-    dacpo_edge_omega(be->alpha, be->alpha_bar, scale, &ie[e].w_same, &ie[e].w_diff);
+    dacpo_edge_omega(be->alpha, be->alpha_bar, s->evidence_scale, &ie[e].w_same,
+                     &ie[e].w_diff);
     if (be->alpha == 0.0 && be->alpha_bar == 0.0)
       st->zero_weight_edges++;
   }
@@ -352,10 +354,9 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
   }
   for (size_t b = 0; b < nb; ++b)
     root[b] = (int32_t)b;
-  const double scale = dacpo_edge_evidence_scale(&s->bgraph);
   for (size_t e = 0; e < s->bgraph.num_edges; ++e) {
     const dacpo_block_edge* be = &s->bgraph.edges[e];
-    if (!(be->alpha + be->alpha_bar >= weak * scale))
+    if (!(be->alpha + be->alpha_bar >= weak * s->evidence_scale))
       continue;
     int32_t a = be->a, b = be->b;
     while (root[a] != a)
@@ -451,8 +452,8 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
     for (int d = 0; d < 3; ++d)
       final[3 * i + d] = f * s->oriented[3 * i + d];
   }
-  dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->p.seed,
-                                         s->part_sign, s->part_conf, &st->view_score, err);
+  dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->part_sign,
+                                    s->part_conf, &st->view_score, err);
   free(final);
   if (r == DACPO_OK && np > s->num_components)
     r = keep_weak_evidence(s, np, err);
@@ -507,7 +508,7 @@ publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
  * one component (or bridged into one), the viewpoint vote margin under the
  * VIEWPOINT policy, 0 for every component but the largest under SEPARATE. */
 static double
-component_confidence(const run_state* s, size_t i)
+part_confidence(const run_state* s, size_t i)
 {
   if (s->part_conf)
     return s->part_conf[s->part[i]];
@@ -574,7 +575,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     ctx->point_component[j] = s->input_component[i];
     ctx->point_block[j] = s->blocks.block_of[i];
     ctx->point_confidence[j] = s->point_conf[i] * s->block_conf[s->blocks.block_of[i]] *
-                               (float)component_confidence(s, i);
+                               (float)part_confidence(s, i);
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
