@@ -77,6 +77,7 @@ dacpo_params_init(dacpo_params* p)
   p->vcr_boundary_factor = 1;
   p->dipole_restarts = 4;
   p->weak_edge_fraction = 1.0;
+  p->sign_policy = DACPO_SIGN_FREE_SPACE;
 }
 
 static dacpo_status
@@ -126,6 +127,13 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (!(p->weak_edge_fraction >= 0.0) || !(p->weak_edge_fraction <= 1.0))
     return bad_field(message, size, "weak_edge_fraction must be in [0, 1] (got %g)",
                      p->weak_edge_fraction);
+  if (p->sign_policy != DACPO_SIGN_FREE_SPACE && p->sign_policy != DACPO_SIGN_VIEWPOINT &&
+      p->sign_policy != DACPO_SIGN_KEEP)
+    return bad_field(message, size, "sign_policy must be FREE_SPACE, VIEWPOINT or KEEP (got %d)",
+                     (int)p->sign_policy);
+  if (p->sign_policy == DACPO_SIGN_VIEWPOINT &&
+      !(isfinite(p->viewpoint[0]) && isfinite(p->viewpoint[1]) && isfinite(p->viewpoint[2])))
+    return bad_field(message, size, "viewpoint must be finite");
   if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
     return bad_field(message, size, "dipole_final_sweep must be in [0, 1000] (got %d)",
                      p->dipole_final_sweep);

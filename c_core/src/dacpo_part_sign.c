@@ -35,7 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { DACPO_VIEW_SAMPLE = 4096, DACPO_VIEW_CANDIDATES = 1024 };
+enum { DACPO_VIEW_CANDIDATES = 1024 };
 #define DACPO_VIEW_MIN_SCORE 0.75
 #ifndef DACPO_VIEW_TIE
 #define DACPO_VIEW_TIE 0.0005
@@ -99,16 +99,14 @@ dacpo_part_signs(const double* xyz,
 
   size_t* size = dacpo_calloc_array(num_parts, sizeof(size_t));
   double* vote = dacpo_calloc_array(num_parts, sizeof(double));
-  double* sp = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
-  double* sn = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
-  int32_t* sc = dacpo_malloc_array(DACPO_VIEW_SAMPLE, sizeof(int32_t));
-  if (!size || !vote || !sp || !sn || !sc) {
-    free(sc);
+  dacpo_view_sample vs;
+  dacpo_status st = dacpo_view_sample_take(xyz, nrm, part, n, &vs, err);
+  if (!size || !vote || st != DACPO_OK) {
     free(size);
     free(vote);
-    free(sp);
-    free(sn);
-    return DACPO_OOM(err);
+    if (st == DACPO_OK)
+      dacpo_view_sample_free(&vs);
+    return st == DACPO_OK ? DACPO_OOM(err) : st;
   }
   for (size_t i = 0; i < n; ++i)
     size[part[i]]++;
@@ -117,30 +115,6 @@ dacpo_part_signs(const double* xyz,
     if (size[c] > size[big])
       big = c;
 
-  /* Evenly strided sample of the whole cloud and its bounding box. */
-  const size_t stride =
-      n > DACPO_VIEW_SAMPLE ? (n + DACPO_VIEW_SAMPLE - 1) / DACPO_VIEW_SAMPLE : 1;
-  size_t m = 0;
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
-         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (size_t i = 0; i < n; ++i) {
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = fmin(lo[d], xyz[3 * i + d]);
-      hi[d] = fmax(hi[d], xyz[3 * i + d]);
-    }
-    if (i % stride == 0 && m < DACPO_VIEW_SAMPLE) {
-      memcpy(sp + 3 * m, xyz + 3 * i, 3 * sizeof(double));
-      memcpy(sn + 3 * m, nrm + 3 * i, 3 * sizeof(double));
-      sc[m++] = part[i];
-    }
-  }
-  const double diam =
-      sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-           (hi[2] - lo[2]) * (hi[2] - lo[2]));
-
-  /* Candidates: sample points pushed along either side of their normal (a
-   * part's sign is not known yet) by 1/4 .. 2 scene diameters. */
-  static const double push[4] = {0.25, 0.5, 1.0, 2.0};
   /* The candidates do not depend on the run's seed: the parts' relation is a
    * property of the scene, every seed should find the same one. Two stacked
    * parts (a table top over the floor) are explained as well by a viewpoint
@@ -149,16 +123,14 @@ dacpo_part_signs(const double* xyz,
    * farther from the points is kept, since a sensor stands back from what it
    * scans. */
   dacpo_rng rng;
-  dacpo_rng_seed(&rng, 0x7669657770ull /* "viewp" */, 0);
+  dacpo_view_rng_seed(&rng);
   double best_v[3] = {0.0, 0.0, 0.0}, facing = -1.0, best_dist = 0.0;
-  for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && m > 0; ++k) {
-    const size_t j = dacpo_rng_below(&rng, m);
-    const double t = (k & 4u ? -1.0 : 1.0) * push[k % 4] * diam;
-    const double v[3] = {sp[3 * j] + t * sn[3 * j],
-                         sp[3 * j + 1] + t * sn[3 * j + 1],
-                         sp[3 * j + 2] + t * sn[3 * j + 2]};
+  for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && vs.m > 0; ++k) {
+    double v[3];
+    dacpo_view_candidate(&vs, &rng, k, v);
     double dist;
-    const double score = view_score(sp, sn, sc, m, v, vote, num_parts, &dist);
+    const double score =
+        view_score(vs.p, vs.n, vs.part, vs.m, v, vote, num_parts, &dist);
     if (score > facing + DACPO_VIEW_TIE ||
         (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
       facing = fmax(score, facing);
@@ -191,8 +163,74 @@ dacpo_part_signs(const double* xyz,
   confidence[big] = 1.0;
   free(size);
   free(vote);
-  free(sp);
-  free(sn);
-  free(sc);
+  dacpo_view_sample_free(&vs);
   return DACPO_OK;
+}
+
+dacpo_status
+dacpo_view_sample_take(const double* xyz,
+                       const double* nrm,
+                       const int32_t* part,
+                       size_t n,
+                       dacpo_view_sample* s,
+                       dacpo_err* err)
+{
+  memset(s, 0, sizeof(*s));
+  s->p = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
+  s->n = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
+  s->part = dacpo_malloc_array(DACPO_VIEW_SAMPLE, sizeof(int32_t));
+  if (!s->p || !s->n || !s->part) {
+    dacpo_view_sample_free(s);
+    return DACPO_OOM(err);
+  }
+  /* Evenly strided sample of the whole cloud and its bounding box. */
+  const size_t stride =
+      n > DACPO_VIEW_SAMPLE ? (n + DACPO_VIEW_SAMPLE - 1) / DACPO_VIEW_SAMPLE : 1;
+  s->stride = stride;
+  for (int d = 0; d < 3; ++d) {
+    s->lo[d] = HUGE_VAL;
+    s->hi[d] = -HUGE_VAL;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (int d = 0; d < 3; ++d) {
+      s->lo[d] = fmin(s->lo[d], xyz[3 * i + d]);
+      s->hi[d] = fmax(s->hi[d], xyz[3 * i + d]);
+    }
+    if (i % stride == 0 && s->m < DACPO_VIEW_SAMPLE) {
+      memcpy(s->p + 3 * s->m, xyz + 3 * i, 3 * sizeof(double));
+      memcpy(s->n + 3 * s->m, nrm + 3 * i, 3 * sizeof(double));
+      s->part[s->m++] = part ? part[i] : 0;
+    }
+  }
+  double dd = 0.0;
+  for (int d = 0; d < 3 && n > 0; ++d)
+    dd += (s->hi[d] - s->lo[d]) * (s->hi[d] - s->lo[d]);
+  s->diam = sqrt(dd);
+  return DACPO_OK;
+}
+
+void
+dacpo_view_sample_free(dacpo_view_sample* s)
+{
+  free(s->p);
+  free(s->n);
+  free(s->part);
+  memset(s, 0, sizeof(*s));
+}
+
+void
+dacpo_view_rng_seed(dacpo_rng* rng)
+{
+  dacpo_rng_seed(rng, 0x7669657770ull /* "viewp" */, 0);
+}
+
+void
+dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3])
+{
+  /* sign unknown: either side of the normal, by 1/4 .. 2 scene diameters */
+  static const double push[4] = {0.25, 0.5, 1.0, 2.0};
+  const size_t j = dacpo_rng_below(rng, s->m);
+  const double t = (k & 4u ? -1.0 : 1.0) * push[k % 4] * s->diam;
+  for (int d = 0; d < 3; ++d)
+    v[d] = s->p[3 * j + d] + t * s->n[3 * j + d];
 }

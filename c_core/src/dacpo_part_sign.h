@@ -26,4 +26,38 @@ dacpo_part_signs(const double* xyz,
                  double* score_out,
                  dacpo_err* err);
 
+/* A strided sample of at most DACPO_VIEW_SAMPLE points (positions, normals,
+ * part ids) and the cloud's bounding box: what the viewpoint searches score
+ * (here and in dacpo_global_sign.c). part may be NULL (every id 0). */
+enum { DACPO_VIEW_SAMPLE = 4096 };
+
+typedef struct dacpo_view_sample {
+  double* p;
+  double* n;
+  int32_t* part;
+  size_t m;
+  size_t stride; /* sample point s is cloud point s * stride */
+  double lo[3], hi[3];
+  double diam; /* bounding-box diagonal */
+} dacpo_view_sample;
+
+dacpo_status
+dacpo_view_sample_take(const double* xyz,
+                       const double* nrm,
+                       const int32_t* part,
+                       size_t n,
+                       dacpo_view_sample* s,
+                       dacpo_err* err);
+
+void
+dacpo_view_sample_free(dacpo_view_sample* s);
+
+/* Candidate viewpoint k of a sequence that depends only on the sample (rng
+ * seeded with dacpo_view_rng_seed): a sample point pushed along either side
+ * of its normal by 1/4 .. 2 scene diameters. */
+void
+dacpo_view_rng_seed(dacpo_rng* rng);
+void
+dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3]);
+
 #endif

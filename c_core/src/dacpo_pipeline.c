@@ -13,6 +13,7 @@
 #include "dacpo_part_sign.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
+#include "dacpo_global_sign.h"
 #include "dacpo_ilp.h"
 #include "dacpo_input.h"
 #include "dacpo_ipsr.h"
@@ -55,6 +56,7 @@ typedef struct run_state {
   int32_t* part;           /* n: part of each point (VIEWPOINT policy) */
   int8_t* part_sign;       /* per part */
   double* part_conf;       /* per part */
+  double global_sign;      /* +1 or -1: stage 6 */
   dacpo_ilp_result ilp;
 } run_state;
 
@@ -429,6 +431,25 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* The normals as they stand after stage 5 (block flips) and, once decided,
+ * the part signs: 3n doubles the caller frees, NULL if out of memory. */
+static double*
+current_normals(const run_state* s)
+{
+  const size_t n = s->cloud.n;
+  double* out = dacpo_malloc_array(3 * n, sizeof(double));
+  if (!out)
+    return NULL;
+  for (size_t i = 0; i < n; ++i) {
+    double f = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
+    if (s->part_sign)
+      f *= (double)s->part_sign[s->part[i]];
+    for (int d = 0; d < 3; ++d)
+      out[3 * i + d] = f * s->oriented[3 * i + d];
+  }
+  return out;
+}
+
 /* Stage 5 decides the relative sign of blocks joined by edges with evidence;
  * where the only evidence between two groups of blocks is weak (or there is
  * none: separate components), each group takes the sign under which it faces
@@ -440,17 +461,12 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
   size_t np = 0;
   DACPO_TRY(label_parts(s, s->p.weak_edge_fraction, &np, err));
   st->num_parts = np;
+  double* final = current_normals(s); /* before s->part_sign exists */
   s->part_sign = dacpo_malloc_array(np, sizeof(int8_t));
   s->part_conf = dacpo_malloc_array(np, sizeof(double));
-  double* final = dacpo_malloc_array(3 * n, sizeof(double));
   if (!s->part_sign || !s->part_conf || !final) {
     free(final);
     return DACPO_OOM(err);
-  }
-  for (size_t i = 0; i < n; ++i) {
-    const double f = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
-    for (int d = 0; d < 3; ++d)
-      final[3 * i + d] = f * s->oriented[3 * i + d];
   }
   dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->part_sign,
                                     s->part_conf, &st->view_score, err);
@@ -463,6 +479,33 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
     related += s->part_conf[c] > 0.0;
   st->parts_related = related > 0 ? related - 1 : 0;
   return r;
+}
+
+/* ---- stage 6: global sign ----------------------------------------------- */
+
+static dacpo_status
+choose_global_sign(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  s->global_sign = 1.0;
+  if (s->p.sign_policy == DACPO_SIGN_KEEP)
+    return DACPO_OK;
+  double* now = current_normals(s);
+  if (!now)
+    return DACPO_OOM(err);
+  dacpo_global_sign_result g;
+  const dacpo_status r = dacpo_global_sign(
+      s->cloud.xyz, now, s->cloud.n,
+      s->p.sign_policy == DACPO_SIGN_VIEWPOINT ? s->p.viewpoint : NULL, s->knn.sqd, s->knn.k,
+      &g, err);
+  free(now);
+  if (r != DACPO_OK)
+    return r;
+  s->global_sign = g.flip ? -1.0 : 1.0;
+  st->sign_flipped = g.flip;
+  st->sign_facing = g.facing;
+  st->sign_enclosed = g.enclosed;
+  memcpy(st->sign_viewpoint, g.viewpoint, sizeof(st->sign_viewpoint));
+  return DACPO_OK;
 }
 
 /* ---- results ----------------------------------------------------------- */
@@ -488,7 +531,7 @@ publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
     const dacpo_mesh* m = &s->meshes[b];
     for (size_t i = 0; i < 3 * m->num_vertices; ++i)
       ctx->mesh_vertices[3 * v0 + i] = (float)m->vertices[i];
-    const int flip = s->flips[b] != 0;
+    const int flip = (s->flips[b] != 0) != (s->global_sign < 0.0);
     for (size_t t = 0; t < m->num_triangles; ++t) {
       int32_t* out = ctx->mesh_triangles + 3 * (t0 + t);
       const int32_t* in = m->triangles + 3 * t;
@@ -567,7 +610,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
       memcpy(axis, c->nrm + 3 * i, sizeof(axis));
     }
     double dot = axis[0] * o[0] + axis[1] * o[1] + axis[2] * o[2];
-    double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip;
+    double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip * s->global_sign;
     if (s->part_sign)
       sign *= (double)s->part_sign[s->part[i]];
     for (int d = 0; d < 3; ++d)
@@ -703,6 +746,7 @@ run(dacpo_ctx* ctx,
   if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT &&
       (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))
     DACPO_TRY(relate_parts(s, st, err));
+  DACPO_TRY(choose_global_sign(s, st, err));
   STAGE_DONE(DACPO_STAGE_ILP);
 
   DACPO_TRY(publish(ctx, s, normals, err));

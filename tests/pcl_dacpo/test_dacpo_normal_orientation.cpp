@@ -508,3 +508,65 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
 }
 
 } // namespace
+
+namespace {
+/** % of output normals that agree with the ground truth as they are (no flip). */
+double
+rightAsGiven(const std::vector<float>& gt, const pcl::PointCloud<pcl::Normal>& out)
+{
+  std::size_t right = 0;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    right += gt[3 * i] * out[i].normal_x + gt[3 * i + 1] * out[i].normal_y +
+                 gt[3 * i + 2] * out[i].normal_z >
+             0.0f;
+  return out.empty() ? 0.0 : 100.0 * double(right) / double(out.size());
+}
+} // namespace
+
+// The sign the caller gets: by default into the open box (free space); facing
+// the cloud's sensor_origin_ or a given viewpoint when asked, like PCL's
+// NormalEstimation, but one sign for the whole cloud.
+TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
+{
+  const Scene scene = makeScene(DACPO_SCENE_BOX_OPEN, 6000);
+  pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
+  skipIPSR(dacpo);
+  EXPECT_EQ(dacpo.getSignPolicy(), DACPO_SIGN_FREE_SPACE);
+  dacpo.setInputCloud(scene.cloud);
+  dacpo.setInputNormals(scene.scrambled);
+  pcl::PointCloud<pcl::Normal> out;
+  dacpo.compute(out);
+  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  EXPECT_GT(rightAsGiven(scene.gt, out), 99.0);
+
+  // a sensor far out below the x = 0, y = 0 corner (the box is [0, 4] x [0, 3]
+  // x [0, 2.5]): the floor and the x = 0 and y = 0 walls (29.5 of 47 m^2) face
+  // away from it as they are, so the one sign that makes most normals face it
+  // (29.5 / 47 = 63 % of the points) turns the whole box inside out
+  pcl::PointCloud<pcl::PointXYZ>::Ptr moved(new pcl::PointCloud<pcl::PointXYZ>(*scene.cloud));
+  moved->sensor_origin_ = Eigen::Vector4f(-1000.0f, -1000.0f, -1000.0f, 1.0f);
+  dacpo.setInputCloud(moved);
+  dacpo.useSensorOriginAsViewPoint();
+  EXPECT_EQ(dacpo.getSignPolicy(), DACPO_SIGN_VIEWPOINT);
+  dacpo.compute(out);
+  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  EXPECT_LT(rightAsGiven(scene.gt, out), 1.0);
+  EXPECT_NEAR(dacpo.getStats().sign_facing, 29.5 / 47.0, 0.03);
+  EXPECT_EQ(dacpo.getStats().sign_viewpoint[2], -1000.0);
+
+  // an explicit viewpoint inside the box wins over the sensor origin
+  dacpo.setViewPoint(2.0f, 1.5f, 1.0f);
+  float vx, vy, vz;
+  dacpo.getViewPoint(vx, vy, vz);
+  EXPECT_EQ(vz, 1.0f);
+  dacpo.compute(out);
+  EXPECT_GT(rightAsGiven(scene.gt, out), 99.0);
+  EXPECT_GT(dacpo.getStats().sign_facing, 0.99);
+
+  // KEEP: the method's own sign, the same normals up to one flip
+  dacpo.setSignPolicy(DACPO_SIGN_KEEP);
+  pcl::PointCloud<pcl::Normal> kept;
+  dacpo.compute(kept);
+  EXPECT_EQ(dacpo.getStats().sign_flipped, 0);
+  EXPECT_LT(wrongPercent(scene.gt, kept), kMaxWrongBox);
+}

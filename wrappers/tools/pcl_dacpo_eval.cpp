@@ -57,7 +57,8 @@ printHelp(int, char** argv)
       "                     -json            = print one line of JSON on stdout:\n");
   print_info("  {\"file\":..., \"points\":N, \"wrong_pct\":x, "
              "\"largest_component_points\":M,\n");
-  print_info("   \"largest_component_wrong_pct\":y, \"components\":C}\n");
+  print_info("   \"largest_component_wrong_pct\":y, \"components\":C,\n");
+  print_info("   \"right_sign_pct\": %% right as given, without the global flip}\n");
   print_info(
       "  If the prediction has a 'block' field (pcl_dacpo_orient -labels), also:\n");
   print_info("   \"blocks\":B, \"component_wrong_pct\": with the best sign per "
@@ -448,8 +449,10 @@ main(int argc, char** argv)
     return 1;
   }
 
-  /* Per point under the global sign chosen for the all-points score. */
+  /* Per point under the global sign chosen for the all-points score;
+   * facing_pct: right without that choice (the sign the user gets). */
   std::vector<bool> wrong(n);
+  double facing_pct = 0.0;
   {
     std::size_t wrong_pos = 0, wrong_neg = 0;
     std::vector<double> dot(n);
@@ -461,6 +464,7 @@ main(int argc, char** argv)
       wrong_neg += !(dot[i] < 0.0);
     }
     const bool flip = wrong_neg < wrong_pos;
+    facing_pct = n ? 100.0 * static_cast<double>(n - wrong_pos) / static_cast<double>(n) : 0.0;
     for (std::size_t i = 0; i < n; ++i)
       wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
   }
@@ -511,13 +515,14 @@ main(int argc, char** argv)
     std::printf(
         "{\"file\":%s, \"points\":%zu, \"wrong_pct\":%.4f, "
         "\"largest_component_points\":%zu, \"largest_component_wrong_pct\":%.4f, "
-        "\"components\":%zu",
+        "\"components\":%zu, \"right_sign_pct\":%.4f",
         jsonString(files[1]).c_str(),
         n,
         pct_all,
         sizes[largest],
         pct_largest,
-        components);
+        components,
+        facing_pct);
     if (has_confidence)
       std::printf(", \"wrong_in_least_confident10_pct\":%.4f, "
                   "\"least_confident10_wrong_pct\":%.4f",
@@ -557,7 +562,9 @@ main(int argc, char** argv)
     print_value("%.2f%%", pct_largest);
     print_info(" of ");
     print_value("%zu", sizes[largest]);
-    print_info(" points\n");
+    print_info(" points; with the sign as given (no global flip): ");
+    print_value("%.2f%%", facing_pct);
+    print_info(" right\n");
     if (has_confidence) {
       print_info("  The least confident 10%% of the points hold ");
       print_value("%.1f%%", wrong_in_low10);

@@ -137,6 +137,14 @@ printHelp(int, char** argv)
              "(trimmed iPSR\n"
              "                                   block meshes, wound like the output "
              "normals)\n");
+  print_info("                     -sign free|keep = global sign: normals face the free "
+             "space the scan\n"
+             "                                   was seen from (free, default; closed "
+             "objects: outward),\n"
+             "                                   or the arbitrary one of the method (keep)\n");
+  print_info("                     -vp x,y,z   = most normals face this viewpoint (one sign "
+             "for the whole\n"
+             "                                   cloud, consistency is kept)\n");
   print_info("                     -separate   = disconnected parts keep the sign they "
              "got (undefined relative sign)\n"
              "                                   (default: each part takes the sign that "
@@ -691,6 +699,35 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
+  std::string sign;
+  if (parse_argument(argc, argv, "-sign", sign) >= 0) {
+    if (sign == "free")
+      o.params.sign_policy = DACPO_SIGN_FREE_SPACE;
+    else if (sign == "keep")
+      o.params.sign_policy = DACPO_SIGN_KEEP;
+    else {
+      print_error("Error: -sign must be free or keep (for a viewpoint use -vp x,y,z), got "
+                  "'%s'\n",
+                  sign.c_str());
+      return false;
+    }
+  }
+  if (find_argument(argc, argv, "-vp") >= 0) {
+    double vx = 0.0, vy = 0.0, vz = 0.0;
+    if (parse_3x_arguments(argc, argv, "-vp", vx, vy, vz) < 0 || !std::isfinite(vx) ||
+        !std::isfinite(vy) || !std::isfinite(vz)) {
+      print_error("Error: -vp needs three finite numbers x,y,z\n");
+      return false;
+    }
+    if (o.params.sign_policy == DACPO_SIGN_KEEP) {
+      print_error("Error: -vp and -sign keep contradict each other\n");
+      return false;
+    }
+    o.params.sign_policy = DACPO_SIGN_VIEWPOINT;
+    o.params.viewpoint[0] = vx;
+    o.params.viewpoint[1] = vy;
+    o.params.viewpoint[2] = vz;
+  }
   if (find_switch(argc, argv, "-separate"))
     o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
   if (find_switch(argc, argv, "-bridge"))
@@ -798,7 +835,7 @@ main(int argc, char** argv)
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "solver_optimal=%d ipsr_iterations_mean=%.2f "
+               "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
                s.num_blocks,
@@ -809,6 +846,9 @@ main(int argc, char** argv)
                s.parts_related,
                s.view_score,
                s.flipped_blocks,
+               s.sign_flipped,
+               s.sign_facing,
+               s.sign_enclosed,
                s.solver_optimal ? 1 : 0,
                s.num_blocks ? static_cast<double>(s.ipsr_iterations_total) /
                                   static_cast<double>(s.num_blocks)

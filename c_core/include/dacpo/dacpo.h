@@ -112,6 +112,20 @@ typedef enum dacpo_disconnected_policy {
   DACPO_DISCONNECTED_VIEWPOINT = 3
 } dacpo_disconnected_policy;
 
+/** \brief Which of the two consistent orientations the run returns. */
+typedef enum dacpo_sign_policy {
+  /** Normals face the free space the scene was seen from: the viewpoint
+   *  that most normals face and that sees most of the scene (normals face
+   *  away from it when it lies inside a closed surface: objects come out
+   *  with outward normals). No sensor position needed. */
+  DACPO_SIGN_FREE_SPACE = 0,
+  /** Most normals face dacpo_params::viewpoint (a sensor origin); one sign
+   *  for the whole cloud, so consistency is kept. */
+  DACPO_SIGN_VIEWPOINT = 1,
+  /** Whatever sign stage 5 left (the paper's: arbitrary). */
+  DACPO_SIGN_KEEP = 2
+} dacpo_sign_policy;
+
 /**
  * \brief Parameters. Always start from dacpo_params_init(); new fields are only
  * ever appended.
@@ -169,6 +183,9 @@ typedef struct dacpo_params {
                                   edge below the median; measured on 15 real
                                   frames x 5 seeds: worst seed 8.55 % -> 5.75 %
                                   against 0.1, rooms unchanged) */
+  dacpo_sign_policy sign_policy; /**< global sign (DACPO_SIGN_FREE_SPACE) */
+  double viewpoint[3]; /**< DACPO_SIGN_VIEWPOINT: the point normals face,
+                            in the input's frame (0, 0, 0) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -250,6 +267,12 @@ typedef struct dacpo_stats {
                                  under their part's sign (0 if unused) */
   size_t parts_related;     /**< parts other than the largest whose sign the vote
                                  set (confidence > 0) */
+  int sign_flipped;         /**< 1 if the sign policy turned every normal over */
+  double sign_facing;       /**< share of the points facing the viewpoint the sign
+                                 policy used (away from it if enclosed), 0 if KEEP */
+  int sign_enclosed;        /**< FREE_SPACE: 1 if that viewpoint lies inside a
+                                 closed surface (normals point away from it) */
+  double sign_viewpoint[3]; /**< the viewpoint the sign policy used */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -348,6 +348,52 @@ public:
     return params_.weak_edge_fraction;
   }
 
+  /** \brief Which of the two consistent orientations to return (default
+   *  DACPO_SIGN_FREE_SPACE: normals face the free space the scan was seen from,
+   *  no sensor position needed; closed objects get outward normals). */
+  void
+  setSignPolicy(dacpo_sign_policy policy)
+  {
+    params_.sign_policy = policy;
+    if (policy != DACPO_SIGN_VIEWPOINT)
+      use_sensor_origin_ = false;
+  }
+  /** \brief See setSignPolicy(). */
+  dacpo_sign_policy
+  getSignPolicy() const
+  {
+    return params_.sign_policy;
+  }
+
+  /** \brief Make most normals face (vpx, vpy, vpz), as PCL's NormalEstimation
+   *  does, but with one sign for the whole cloud so consistency is kept
+   *  (sets DACPO_SIGN_VIEWPOINT). */
+  void
+  setViewPoint(float vpx, float vpy, float vpz)
+  {
+    params_.sign_policy = DACPO_SIGN_VIEWPOINT;
+    params_.viewpoint[0] = vpx;
+    params_.viewpoint[1] = vpy;
+    params_.viewpoint[2] = vpz;
+    use_sensor_origin_ = false;
+  }
+  /** \brief The viewpoint set by setViewPoint() (0, 0, 0 if none). */
+  void
+  getViewPoint(float& vpx, float& vpy, float& vpz) const
+  {
+    vpx = static_cast<float>(params_.viewpoint[0]);
+    vpy = static_cast<float>(params_.viewpoint[1]);
+    vpz = static_cast<float>(params_.viewpoint[2]);
+  }
+  /** \brief Face the input cloud's sensor_origin_ (read at compute() time;
+   *  sets DACPO_SIGN_VIEWPOINT). */
+  void
+  useSensorOriginAsViewPoint()
+  {
+    params_.sign_policy = DACPO_SIGN_VIEWPOINT;
+    use_sensor_origin_ = true;
+  }
+
   /** \brief What to do with a disconnected k-NN graph (default: relate the parts
    *  by the viewpoint the largest one implies, DACPO_DISCONNECTED_VIEWPOINT). */
   void
@@ -591,6 +637,7 @@ private:
   fail(PointCloudOut& output, dacpo_status status, const std::string& message);
 
   dacpo_params params_;
+  bool use_sensor_origin_ = false;
   ProgressCallback progress_;
 
   /** Type-erased input normals: the cloud (kept alive), its size and a reader. */

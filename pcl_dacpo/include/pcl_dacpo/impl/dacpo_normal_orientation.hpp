@@ -336,6 +336,9 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   progress.user = &progress_adapter;
 
   dacpo_params params = getParameters();
+  if (use_sensor_origin_)
+    for (int d = 0; d < 3; ++d)
+      params.viewpoint[d] = static_cast<double>(input_->sensor_origin_[d]);
 
   dacpo_ctx* raw = nullptr;
   dacpo_status status = dacpo_ctx_create(&raw);
