@@ -106,6 +106,8 @@ def run_one(opt, f, seed):
                        comp_best=ev.get("component_wrong_pct", ev["wrong_pct"]),
                        in_block=ev.get("intra_block_wrong_pct", ev["wrong_pct"]),
                        blocks=ev.get("blocks", 0), components=ev["components"])
+            if "right_sign_pct" in ev:
+                rec["right_sign"] = ev["right_sign_pct"]
             if "wrong_in_least_confident10_pct" in ev:
                 rec["wrong_in_low_conf10"] = ev["wrong_in_least_confident10_pct"]
             rec["flip"] = rec["comp_best"] - rec["in_block"]
@@ -129,23 +131,29 @@ def summarize(recs):
                 wall_s=statistics.median(r["wall_s"] for r in ok),
                 low_conf10=(statistics.median(r["wrong_in_low_conf10"] for r in ok)
                             if all("wrong_in_low_conf10" in r for r in ok) else None),
+                right_sign=(sum(r["right_sign"] > 50.0 for r in ok)
+                            if all("right_sign" in r for r in ok) else None),
                 per_seed={str(r["seed"]): round(r["wrong"], 3) for r in ok})
 
 
 def table(label, groups):
     lines = [f"### {label}", "",
-             "| file | points | median % | worst % | spread | in-block | flip | component | s/run |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| file | points | median % | worst % | spread | in-block | flip | component | right sign | s/run |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    sign = lambda s: "—" if s["right_sign"] is None else f"{s['right_sign']}/{s['runs']}"
     for gname, rows in groups:
         for s in rows:
             lines.append(f"| {s['file']} | {s['points']} | {s['median']:.2f} | {s['worst']:.2f} | "
                          f"{s['spread']:.2f} | {s['in_block']:.2f} | {s['flip']:.2f} | "
-                         f"{s['component']:.2f} | {s['wall_s']:.1f} |")
+                         f"{s['component']:.2f} | {sign(s)} | {s['wall_s']:.1f} |")
         if rows:
             m = lambda k: sum(r[k] for r in rows) / len(rows)
+            signs = [r for r in rows if r["right_sign"] is not None]
+            total_sign = (f"{sum(r['right_sign'] for r in signs)}/{sum(r['runs'] for r in signs)}"
+                          if signs else "—")
             lines.append(f"| **mean {gname}** ({len(rows)}) | | **{m('median'):.2f}** | {m('worst'):.2f} | "
                          f"max {max(r['spread'] for r in rows):.2f} | {m('in_block'):.2f} | "
-                         f"{m('flip'):.2f} | {m('component'):.2f} | {m('wall_s'):.1f} |")
+                         f"{m('flip'):.2f} | {m('component'):.2f} | {total_sign} | {m('wall_s'):.1f} |")
     return "\n".join(lines)
 
 
