@@ -61,6 +61,73 @@ fileArguments(int argc,
   return files;
 }
 
+/** Edit distance (insert, delete, substitute) of two short strings. */
+inline std::size_t
+editDistance(const std::string& a, const std::string& b)
+{
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1u : 0u)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/** Every argument must be a known switch, a known option followed by its
+ *  value, or a .pcd/.ply file: a typo ("-frobnicate 3", "--k 5") must not run
+ *  silently with defaults. On failure returns false with a message naming the
+ *  argument and, when one is close, the option meant. */
+inline bool
+checkArguments(int argc,
+               char** argv,
+               std::initializer_list<const char*> switches,
+               std::initializer_list<const char*> valued,
+               std::string& error)
+{
+  auto in = [](std::initializer_list<const char*> list, const std::string& a) {
+    return std::any_of(list.begin(), list.end(), [&](const char* o) { return a == o; });
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (in(valued, a)) {
+      ++i; /* its value (a missing one is the option parser's to report) */
+      continue;
+    }
+    if (in(switches, a))
+      continue;
+    if (!a.empty() && a[0] == '-') {
+      std::string best;
+      std::size_t best_d = 3; /* suggest only close names */
+      const std::string bare = a.substr(a.find_first_not_of('-'));
+      for (auto list : {switches, valued})
+        for (const char* o : list) {
+          const std::size_t d = std::min(editDistance(a, o), editDistance("-" + bare, o));
+          if (d < best_d) {
+            best_d = d;
+            best = o;
+          }
+        }
+      error = "unknown option '" + a + "'" +
+              (best.empty() ? std::string() : "; did you mean '" + best + "'?") +
+              " (-h lists the options)";
+      return false;
+    }
+    const std::string ext = extension(a);
+    if (ext != ".pcd" && ext != ".ply") {
+      error = "unexpected argument '" + a + "': files must be .pcd or .ply";
+      return false;
+    }
+  }
+  return true;
+}
+
 /** Loads a .pcd or .ply into \a cloud and checks it is complete and has x, y, z.
  *  On failure returns false with a message in \a error. */
 inline bool

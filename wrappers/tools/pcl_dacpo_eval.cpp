@@ -343,9 +343,17 @@ saveColored(const std::string& path,
 int
 main(int argc, char** argv)
 {
-  if (argc < 3 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+  const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  if (argc < 3 || help) {
     printHelp(argc, argv);
-    return argc < 3 ? 1 : 0;
+    return help ? 0 : 1;
+  }
+  {
+    std::string error;
+    if (!dacpo_tool::checkArguments(argc, argv, {"-json"}, {"-colored"}, error)) {
+      print_error("Error: %s\n", error.c_str());
+      return 1;
+    }
   }
   const std::vector<std::string> files =
       dacpo_tool::fileArguments(argc, argv, {"-colored"});

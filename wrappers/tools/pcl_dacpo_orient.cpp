@@ -783,11 +783,26 @@ parseOptions(int argc, char** argv, Options& o)
 int
 main(int argc, char** argv)
 {
-  if (argc < 3 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+  const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  if (argc < 3 || help) {
     print_info("Orient normals with DACPO. For more information, use: %s -h\n",
                argv[0]);
     printHelp(argc, argv);
-    return argc < 3 ? 1 : 0;
+    return help ? 0 : 1;
+  }
+  {
+    std::string error;
+    if (!dacpo_tool::checkArguments(
+            argc, argv,
+            {"-estimate", "-vcr_perspective", "-vcr_c1c2", "-no_ipsr", "-separate", "-bridge",
+             "-q", "-labels"},
+            {"-k", "-normal_k", "-blocks", "-ring", "-c", "-orders", "-restarts", "-band",
+             "-weak", "-weights", "-vcr_size", "-vcr_views", "-time_limit", "-seed",
+             "-threads", "-sign", "-vp", "-mesh", "-edges", "-blocks_colored"},
+            error)) {
+      print_error("Error: %s\n", error.c_str());
+      return 1;
+    }
   }
   const std::vector<std::string> files =
       dacpo_tool::fileArguments(argc, argv, {"-edges", "-blocks_colored", "-mesh"});
