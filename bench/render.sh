@@ -6,7 +6,12 @@
 # side by side with ImageMagick.
 #
 #   bench/render.sh [-b BUILD] [-w WORK] [-o OUT.png] [-n POINTS] [-seed S]
-#                   [-peer cgal|pcl_viewpoint|open3d] [-- extra pcl_dacpo_orient args]
+#                   [-peer cgal|pcl_viewpoint|open3d] [-sign] [-- extra pcl_dacpo_orient args]
+#
+# -sign: colour by normal direction instead, RGB = (n + 1) / 2 (pcl_dacpo_eval
+# -normals_colored), titled with the share right as returned (no flip forgiven):
+# what a user sees of the global sign (a room turned inside out shows a dark
+# floor).
 #
 # Needs pcl_viewer (pcl-tools), xvfb-run (xvfb, xauth) and ImageMagick
 # (scripts/install_deps.sh + scripts/install_bench_deps.sh). Peers are built
@@ -19,6 +24,7 @@ out="$root/bench/results/room_dacpo_vs_peer.png"
 points=100000
 seed=1
 peer=cgal
+sign=0
 while [ $# -gt 0 ]; do
   case "$1" in
     -b) build="$(cd "$2" && pwd)"; shift 2 ;;
@@ -27,6 +33,7 @@ while [ $# -gt 0 ]; do
     -n) points="$2"; shift 2 ;;
     -seed) seed="$2"; shift 2 ;;
     -peer) peer="$2"; shift 2 ;;
+    -sign) sign=1; shift ;;
     -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     --) shift; break ;;
     *) echo "render: unknown option $1" >&2; exit 2 ;;
@@ -68,9 +75,14 @@ room="$dir/room_${points}_s$seed.ply"
 [ -f "$room" ] || "$tools/dacpo_make_scene" "$room" -scene room -n "$points" -seed "$seed" >/dev/null
 "$tools/pcl_dacpo_orient" "$room" "$dir/dacpo.pcd" -estimate -q "${extra[@]}" 2>/dev/null
 "${peer_cmd[@]}" "$room" "$peer_out" 2>/dev/null
-pct() { # gt pred colored.pcd -> wrong %
-  "$tools/pcl_dacpo_eval" "$1" "$2" -colored "$3" -json |
-    sed -n 's/.*"wrong_pct":\([0-9.]*\).*/\1/p' | tail -1 | awk '{printf "%.2f", $1}'
+pct() { # gt pred colored.pcd -> wrong % (-sign: % right as returned, normal colours)
+  if [ "$sign" = 1 ]; then
+    "$tools/pcl_dacpo_eval" "$1" "$2" -normals_colored "$3" -json |
+      sed -n 's/.*"right_sign_pct":\([0-9.]*\).*/\1/p' | tail -1 | awk '{printf "%.2f", $1}'
+  else
+    "$tools/pcl_dacpo_eval" "$1" "$2" -colored "$3" -json |
+      sed -n 's/.*"wrong_pct":\([0-9.]*\).*/\1/p' | tail -1 | awk '{printf "%.2f", $1}'
+  fi
 }
 w_dacpo=$(pct "$room" "$dir/dacpo.pcd" "$dir/dacpo_colored.pcd")
 w_peer=$(pct "$room" "$peer_out" "$dir/peer_colored.pcd")
@@ -106,10 +118,17 @@ label() { # png text: trim the white margin, title on top
   convert "$1" -fuzz 4% -trim +repage -bordercolor white -border 30 -gravity north -background white \
     -splice 0x40 -font DejaVu-Sans -pointsize 24 -fill black -annotate +0+14 "$2" "$1"
 }
-label "$dir/dacpo.png" "pcl_dacpo: ${w_dacpo}% wrong"
-label "$dir/peer.png" "$peer_title: ${w_peer}% wrong"
+if [ "$sign" = 1 ]; then
+  what="right"
+  legend="signs as returned, colour = normal direction, RGB = (n + 1) / 2: up is blue, down olive"
+else
+  what="wrong"
+  legend="blue = correct, red = wrong"
+fi
+label "$dir/dacpo.png" "pcl_dacpo: ${w_dacpo}% $what"
+label "$dir/peer.png" "$peer_title: ${w_peer}% $what"
 convert "$dir/dacpo.png" "$dir/peer.png" -background white -gravity center +append \
   \( -size $((2 * W))x36 xc:white -gravity center -font DejaVu-Sans -pointsize 18 -fill '#333333' \
-     -annotate +0+0 "generated room, $points points (seed $seed), PCA normals (k=16) oriented; blue = correct, red = wrong" \) \
+     -annotate +0+0 "generated room, $points points (seed $seed), PCA normals (k=16) oriented; $legend" \) \
   -append "$out"
-echo "render: wrote $out (pcl_dacpo ${w_dacpo}% wrong, $peer_title ${w_peer}% wrong)"
+echo "render: wrote $out (pcl_dacpo ${w_dacpo}% $what, $peer_title ${w_peer}% $what)"

@@ -25,6 +25,11 @@
 #   check_cli.sh known_blocks EVAL DIR
 #       known answer: 3 blocks of 100 points, one right, one flipped, one with 10
 #       points flipped: wrong 36.67 %, in-block 3.33 %, 1 flip-wrong block.
+#   check_cli.sh sign_colors ORIENT EVAL box.ply colored.pcd
+#       orienting the open box towards a viewpoint inside it with -vp and
+#       -normals_colored must give a PCD with x y z rgb and normals that face
+#       into the box as returned (right_sign_pct > 99); the default sign
+#       (no -vp) must do the same.
 #   check_cli.sh truncate SRC DST BYTES
 #       writes the first BYTES bytes of SRC to DST (a truncated input).
 #   check_cli.sh empty DST
@@ -175,6 +180,19 @@ known_blocks)
     '"flip_wrong_points_pct":33.3333' \
     '"largest_block_wrong":\[{"id":1, "component":0, "points":100, "wrong_pct":100.00}, {"id":2, "component":0, "points":100, "wrong_pct":10.00}, {"id":0, "component":0, "points":100, "wrong_pct":0.00}\]'; do
     echo "$json" | grep -q "$kv" || fail "expected $kv"
+  done
+  ;;
+sign_colors)
+  [ $# -eq 5 ] || fail "sign_colors needs ORIENT EVAL box.ply colored.pcd"
+  for vp in "-vp 2,1.5,1.2" ""; do
+    # shellcheck disable=SC2086
+    "$2" "$4" "$(dirname "$5")/sign_out.pcd" -q -normals_colored "$5" $vp 2>/dev/null ||
+      fail "pcl_dacpo_orient -normals_colored $vp exited with $?"
+    head -c 400 "$5" | grep -q "^FIELDS x y z rgb normal_x normal_y normal_z" ||
+      fail "$5 lacks x y z rgb normal_x normal_y normal_z"
+    json=$("$3" "$4" "$5" -json) || fail "pcl_dacpo_eval exited with $?"
+    right=$(json_number "$json" right_sign_pct)
+    holds "$right" 99 "a > b" || fail "right_sign_pct $right <= 99 with '$vp'"
   done
   ;;
 truncate)

@@ -6,9 +6,11 @@
 
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
+#include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/PCLPointCloud2.h>
+#include <pcl/point_types.h>
 
 #include <sys/stat.h>
 
@@ -73,7 +75,8 @@ editDistance(const std::string& a, const std::string& b)
     row[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
       const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1u : 0u)});
+      row[j] = std::min(
+          {row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1u : 0u)});
       diag = up;
     }
   }
@@ -108,7 +111,8 @@ checkArguments(int argc,
       const std::string bare = a.substr(a.find_first_not_of('-'));
       for (auto list : {switches, valued})
         for (const char* o : list) {
-          const std::size_t d = std::min(editDistance(a, o), editDistance("-" + bare, o));
+          const std::size_t d =
+              std::min(editDistance(a, o), editDistance("-" + bare, o));
           if (d < best_d) {
             best_d = d;
             best = o;
@@ -382,6 +386,45 @@ readFloatField(const pcl::PCLPointCloud2& cloud, const char* name)
   for (std::size_t i = 0; i < n; ++i)
     out[i] = static_cast<float>(
         readValue(&cloud.data[i * cloud.point_step + field.offset], field.datatype));
+  return out;
+}
+
+/** x y z rgb normal_x normal_y normal_z of a cloud with normals, every point
+ *  coloured by its normal, RGB = (n + 1) / 2: pcl_viewer draws -normals as
+ *  undirected segments, the colour shows the sign (+z = blue, -z = olive; a
+ *  region facing the wrong way shows in the complementary colour). Points without a
+ * finite normal are black. */
+inline pcl::PCLPointCloud2
+normalsColored(const pcl::PCLPointCloud2& in)
+{
+  const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
+  const std::vector<float> xyz = readTriplet(in, "x", "y", "z");
+  const std::vector<float> nrm = readTriplet(in, "normal_x", "normal_y", "normal_z");
+  pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
+  cloud.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    pcl::PointXYZRGBNormal& p = cloud[i];
+    p.x = xyz[3 * i];
+    p.y = xyz[3 * i + 1];
+    p.z = xyz[3 * i + 2];
+    p.normal_x = nrm[3 * i];
+    p.normal_y = nrm[3 * i + 1];
+    p.normal_z = nrm[3 * i + 2];
+    const bool ok = std::isfinite(nrm[3 * i]) && std::isfinite(nrm[3 * i + 1]) &&
+                    std::isfinite(nrm[3 * i + 2]);
+    std::uint8_t rgb[3] = {0, 0, 0};
+    for (int d = 0; d < 3 && ok; ++d)
+      rgb[d] = static_cast<std::uint8_t>(
+          std::lround(127.5 * (1.0 + std::max(-1.0f, std::min(1.0f, nrm[3 * i + d])))));
+    p.r = rgb[0];
+    p.g = rgb[1];
+    p.b = rgb[2];
+  }
+  cloud.width = in.width;
+  cloud.height = in.height;
+  cloud.is_dense = in.is_dense;
+  pcl::PCLPointCloud2 out;
+  pcl::toPCLPointCloud2(cloud, out);
   return out;
 }
 

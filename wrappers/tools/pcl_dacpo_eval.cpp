@@ -49,6 +49,10 @@ printHelp(int, char** argv)
   print_info(
       "  hold the same points in the same order; NaN predicted normals are wrong.\n");
   print_info("  where options are:\n");
+  print_info(
+      "                     -normals_colored F.{pcd,ply} = the predicted cloud "
+      "coloured by\n"
+      "                                      normal direction, RGB = (n + 1) / 2\n");
   print_info("                     -colored out.pcd = write the points coloured blue "
              "(correct)\n");
   print_info("                                        or red (wrong) with the "
@@ -350,21 +354,29 @@ main(int argc, char** argv)
   }
   {
     std::string error;
-    if (!dacpo_tool::checkArguments(argc, argv, {"-json"}, {"-colored"}, error)) {
+    if (!dacpo_tool::checkArguments(
+            argc, argv, {"-json"}, {"-colored", "-normals_colored"}, error)) {
       print_error("Error: %s\n", error.c_str());
       return 1;
     }
   }
   const std::vector<std::string> files =
-      dacpo_tool::fileArguments(argc, argv, {"-colored"});
+      dacpo_tool::fileArguments(argc, argv, {"-colored", "-normals_colored"});
   if (files.size() != 2) {
     print_error("Need a ground-truth and a predicted file (.pcd or .ply), got %zu.\n",
                 files.size());
     printHelp(argc, argv);
     return 1;
   }
-  std::string colored;
+  std::string colored, normals_colored;
   parse_argument(argc, argv, "-colored", colored);
+  parse_argument(argc, argv, "-normals_colored", normals_colored);
+  if (!normals_colored.empty() && dacpo_tool::extension(normals_colored) != ".pcd" &&
+      dacpo_tool::extension(normals_colored) != ".ply") {
+    print_error("Error: -normals_colored needs a .pcd or .ply file name, got '%s'\n",
+                normals_colored.c_str());
+    return 1;
+  }
   if (!colored.empty() && dacpo_tool::extension(colored) != ".pcd") {
     print_error("Error: -colored needs a .pcd file name, got '%s'\n", colored.c_str());
     return 1;
@@ -472,7 +484,8 @@ main(int argc, char** argv)
       wrong_neg += !(dot[i] < 0.0);
     }
     const bool flip = wrong_neg < wrong_pos;
-    facing_pct = n ? 100.0 * static_cast<double>(n - wrong_pos) / static_cast<double>(n) : 0.0;
+    facing_pct =
+        n ? 100.0 * static_cast<double>(n - wrong_pos) / static_cast<double>(n) : 0.0;
     for (std::size_t i = 0; i < n; ++i)
       wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
   }
@@ -502,6 +515,14 @@ main(int argc, char** argv)
     low10_wrong = low ? 100.0 * wrong_low / low : 0.0;
   }
 
+  if (!normals_colored.empty()) {
+    std::string error;
+    if (!dacpo_tool::saveCloud2(
+            normals_colored, dacpo_tool::normalsColored(pred2), error)) {
+      print_error("Error: %s\n", error.c_str());
+      return 1;
+    }
+  }
   if (!colored.empty()) {
     if (!saveColored(colored, xyz, pred, wrong)) {
       print_error("Error: cannot write '%s'\n", colored.c_str());

@@ -22,8 +22,8 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -69,10 +69,11 @@ struct Options {
   dacpo_params params;
   bool estimate = false;
   bool quiet = false;
-  bool labels = false;        /* -labels: block, component, flip fields */
-  std::string edges;          /* -edges file.csv */
-  std::string blocks_colored; /* -blocks_colored file.{pcd,ply} */
-  std::string mesh;           /* -mesh file.ply */
+  bool labels = false;         /* -labels: block, component, flip fields */
+  std::string edges;           /* -edges file.csv */
+  std::string blocks_colored;  /* -blocks_colored file.{pcd,ply} */
+  std::string normals_colored; /* -normals_colored file.{pcd,ply} */
+  std::string mesh;            /* -mesh file.ply */
 };
 
 /* What a run leaves for the diagnostics, in output (= input) point order. */
@@ -137,30 +138,35 @@ printHelp(int, char** argv)
              "(trimmed iPSR\n"
              "                                   block meshes, wound like the output "
              "normals)\n");
-  print_info("                     -sign free|keep = global sign: normals face the free "
-             "space the scan\n"
-             "                                   was seen from (free, default; closed "
-             "objects: outward),\n"
-             "                                   or the arbitrary one of the method (keep)\n");
-  print_info("                     -vp x,y,z   = most normals face this viewpoint (one sign "
-             "for the whole\n"
-             "                                   cloud, consistency is kept)\n");
-  print_info("                     -separate   = disconnected parts keep the sign they "
-             "got (undefined relative sign)\n"
-             "                                   (default: each part takes the sign that "
-             "faces the viewpoint\n"
-             "                                   implied by the largest part)\n");
-  print_info("                     -weak X     = block edges with less than X times the "
-             "typical evidence\n"
-             "                                   leave their blocks to the viewpoint vote, "
-             "0 = only\n"
-             "                                   disconnected parts (default: ");
+  print_info(
+      "                     -sign free|keep = global sign: normals face the free "
+      "space the scan\n"
+      "                                   was seen from (free, default; closed "
+      "objects: outward),\n"
+      "                                   or the arbitrary one of the method (keep)\n");
+  print_info(
+      "                     -vp x,y,z   = most normals face this viewpoint (one sign "
+      "for the whole\n"
+      "                                   cloud, consistency is kept)\n");
+  print_info(
+      "                     -separate   = disconnected parts keep the sign they "
+      "got (undefined relative sign)\n"
+      "                                   (default: each part takes the sign that "
+      "faces the viewpoint\n"
+      "                                   implied by the largest part)\n");
+  print_info(
+      "                     -weak X     = block edges with less than X times the "
+      "typical evidence\n"
+      "                                   leave their blocks to the viewpoint vote, "
+      "0 = only\n"
+      "                                   disconnected parts (default: ");
   print_value("%g", d.weak_edge_fraction);
   print_info(")\n");
   print_info("                     -bridge     = join disconnected parts along their "
              "minimum spanning tree\n"
              "                                   and orient them as one\n");
-  print_info("                     -band X     = dipole noise band, 0 = off (default: ");
+  print_info(
+      "                     -band X     = dipole noise band, 0 = off (default: ");
   print_value("%g", d.dipole_noise_band);
   print_info(")\n");
   print_info("                     -orders X   = randomized dipole propagation orders "
@@ -196,10 +202,11 @@ printHelp(int, char** argv)
       "                     -threads X  = worker threads, 0 = all cores (default: ");
   print_value("%u", d.num_threads);
   print_info(")\n");
-  print_info("                     -labels     = add int32 fields block, component "
-             "and flip, and the\n"
-             "                                   float field confidence (0..1, how sure the "
-             "sign is)\n");
+  print_info(
+      "                     -labels     = add int32 fields block, component "
+      "and flip, and the\n"
+      "                                   float field confidence (0..1, how sure the "
+      "sign is)\n");
   print_info("                                   (flip = 1 if the 0-1 program flipped "
              "the block;\n");
   print_info("                                   all -1 for skipped points); then "
@@ -217,6 +224,12 @@ printHelp(int, char** argv)
   print_info("                     -blocks_colored F.{pcd,ply} = PointXYZRGB, one "
              "colour per block,\n");
   print_info("                                   darker if flipped, grey if skipped\n");
+  print_info(
+      "                     -normals_colored F.{pcd,ply} = PointXYZRGBNormal "
+      "coloured by\n"
+      "                                   the normal's direction, RGB = (n + 1) / 2: "
+      "a flipped\n"
+      "                                   region shows in the complementary colour\n");
   print_info(
       "                     -q          = quiet: errors and the final stats line "
       "only\n");
@@ -407,10 +420,15 @@ compute(const pcl::PCLPointCloud2& input,
   result.mesh_triangles = dacpo.getMeshTriangles();
 
   /* Keep every input field except the ones we write, then append ours. */
-  pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(
-      input,
-      {"normal_x", "normal_y", "normal_z", "curvature", "block", "component", "flip",
-       "confidence"});
+  pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(input,
+                                                          {"normal_x",
+                                                           "normal_y",
+                                                           "normal_z",
+                                                           "curvature",
+                                                           "block",
+                                                           "component",
+                                                           "flip",
+                                                           "confidence"});
   std::vector<float> values(4 * n);
   for (std::size_t i = 0; i < n; ++i) {
     values[4 * i] = normals_out[i].normal_x;
@@ -615,9 +633,10 @@ saveMesh(const std::string& filename, const Result& r)
   pcl::toPCLPointCloud2(vertices, mesh.cloud);
   mesh.polygons.resize(r.mesh_triangles.size() / 3);
   for (std::size_t t = 0; t < mesh.polygons.size(); ++t)
-    mesh.polygons[t].vertices = {static_cast<pcl::index_t>(r.mesh_triangles[3 * t]),
-                                 static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 1]),
-                                 static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 2])};
+    mesh.polygons[t].vertices = {
+        static_cast<pcl::index_t>(r.mesh_triangles[3 * t]),
+        static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 1]),
+        static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 2])};
   if (pcl::io::savePLYFileBinary(filename, mesh) < 0) {
     print_error("Error: cannot write the mesh to '%s'\n", filename.c_str());
     return false;
@@ -706,9 +725,10 @@ parseOptions(int argc, char** argv, Options& o)
     else if (sign == "keep")
       o.params.sign_policy = DACPO_SIGN_KEEP;
     else {
-      print_error("Error: -sign must be free or keep (for a viewpoint use -vp x,y,z), got "
-                  "'%s'\n",
-                  sign.c_str());
+      print_error(
+          "Error: -sign must be free or keep (for a viewpoint use -vp x,y,z), got "
+          "'%s'\n",
+          sign.c_str());
       return false;
     }
   }
@@ -735,7 +755,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.estimate = find_switch(argc, argv, "-estimate");
   o.quiet = find_switch(argc, argv, "-q");
   o.labels = find_switch(argc, argv, "-labels");
-  for (const char* name : {"-edges", "-blocks_colored", "-mesh"}) {
+  for (const char* name : {"-edges", "-blocks_colored", "-mesh", "-normals_colored"}) {
     const int at = find_argument(argc, argv, name);
     if (at < 0)
       continue;
@@ -743,9 +763,11 @@ parseOptions(int argc, char** argv, Options& o)
       print_error("Error: %s needs a file name\n", name);
       return false;
     }
-    std::string& target = std::strcmp(name, "-edges") == 0
-                              ? o.edges
-                              : (std::strcmp(name, "-mesh") == 0 ? o.mesh : o.blocks_colored);
+    std::string& target = std::strcmp(name, "-edges") == 0  ? o.edges
+                          : std::strcmp(name, "-mesh") == 0 ? o.mesh
+                          : std::strcmp(name, "-normals_colored") == 0
+                              ? o.normals_colored
+                              : o.blocks_colored;
     target = argv[at + 1];
   }
   if (!o.mesh.empty()) {
@@ -759,11 +781,12 @@ parseOptions(int argc, char** argv, Options& o)
     }
     o.params.keep_mesh = 1;
   }
-  if (!o.blocks_colored.empty()) {
-    const std::string ext = dacpo_tool::extension(o.blocks_colored);
-    if (ext != ".pcd" && ext != ".ply") {
-      print_error("Error: -blocks_colored needs a .pcd or .ply file name, got '%s'\n",
-                  o.blocks_colored.c_str());
+  for (const std::string* side : {&o.blocks_colored, &o.normals_colored}) {
+    const std::string ext = dacpo_tool::extension(*side);
+    if (!side->empty() && ext != ".pcd" && ext != ".ply") {
+      print_error("Error: %s needs a .pcd or .ply file name, got '%s'\n",
+                  side == &o.blocks_colored ? "-blocks_colored" : "-normals_colored",
+                  side->c_str());
       return false;
     }
   }
@@ -792,20 +815,44 @@ main(int argc, char** argv)
   }
   {
     std::string error;
-    if (!dacpo_tool::checkArguments(
-            argc, argv,
-            {"-estimate", "-vcr_perspective", "-vcr_c1c2", "-no_ipsr", "-separate", "-bridge",
-             "-q", "-labels"},
-            {"-k", "-normal_k", "-blocks", "-ring", "-c", "-orders", "-restarts", "-band",
-             "-weak", "-weights", "-vcr_size", "-vcr_views", "-time_limit", "-seed",
-             "-threads", "-sign", "-vp", "-mesh", "-edges", "-blocks_colored"},
-            error)) {
+    if (!dacpo_tool::checkArguments(argc,
+                                    argv,
+                                    {"-estimate",
+                                     "-vcr_perspective",
+                                     "-vcr_c1c2",
+                                     "-no_ipsr",
+                                     "-separate",
+                                     "-bridge",
+                                     "-q",
+                                     "-labels"},
+                                    {"-k",
+                                     "-normal_k",
+                                     "-blocks",
+                                     "-ring",
+                                     "-c",
+                                     "-orders",
+                                     "-restarts",
+                                     "-band",
+                                     "-weak",
+                                     "-weights",
+                                     "-vcr_size",
+                                     "-vcr_views",
+                                     "-time_limit",
+                                     "-seed",
+                                     "-threads",
+                                     "-sign",
+                                     "-vp",
+                                     "-mesh",
+                                     "-edges",
+                                     "-blocks_colored",
+                                     "-normals_colored"},
+                                    error)) {
       print_error("Error: %s\n", error.c_str());
       return 1;
     }
   }
-  const std::vector<std::string> files =
-      dacpo_tool::fileArguments(argc, argv, {"-edges", "-blocks_colored", "-mesh"});
+  const std::vector<std::string> files = dacpo_tool::fileArguments(
+      argc, argv, {"-edges", "-blocks_colored", "-mesh", "-normals_colored"});
   if (files.size() != 2) {
     print_error("Need one input and one output file (.pcd or .ply), got %zu.\n",
                 files.size());
@@ -840,6 +887,9 @@ main(int argc, char** argv)
     return 1;
   if (!options.mesh.empty() && !saveMesh(options.mesh, result))
     return 1;
+  if (!options.normals_colored.empty() &&
+      !saveCloud(options.normals_colored, dacpo_tool::normalsColored(output)))
+    return 1;
 
   /* One machine-readable line, printed even with -q (benchmarks grep it). */
   const dacpo_stats& s = result.stats;
@@ -850,7 +900,8 @@ main(int argc, char** argv)
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d ipsr_iterations_mean=%.2f "
+               "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
+               "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
                s.num_blocks,
