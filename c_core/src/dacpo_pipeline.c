@@ -591,6 +591,11 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     info->confidence = fabs(be->alpha - be->alpha_bar) / (be->alpha + be->alpha_bar + 1e-12);
   }
 
+  /* Everything that can fail comes before the caller's normals are written:
+   * they are written only on success. */
+  if (s->p.keep_mesh && s->meshes)
+    DACPO_TRY(publish_mesh(ctx, s, err));
+
   /* The output keeps each input point's own axis (given or PCA) and only takes
    * its sign from the refined, flipped block normal: orientation is what DACPO
    * decides, the axis is the caller's. */
@@ -622,8 +627,6 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
-  if (s->p.keep_mesh && s->meshes)
-    DACPO_TRY(publish_mesh(ctx, s, err));
   st->solver_optimal = s->ilp.optimal;
   st->solver_objective = s->ilp.objective;
   st->ilp_constraints = s->ilp.constraints;
