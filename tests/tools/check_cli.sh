@@ -30,6 +30,11 @@
 #       -normals_colored must give a PCD with x y z rgb and normals that face
 #       into the box as returned (right_sign_pct > 99); the default sign
 #       (no -vp) must do the same.
+#   check_cli.sh bad_files DIR
+#       writes files that are not what their name says: text, zeros and an ELF
+#       binary named .pcd, a PLY renamed to .pcd, ASCII PCD and PLY with a word
+#       among the numbers (PCL 1.13 crashes on the first kind and reads words
+#       as NaN).
 #   check_cli.sh truncate SRC DST BYTES
 #       writes the first BYTES bytes of SRC to DST (a truncated input).
 #   check_cli.sh empty DST
@@ -194,6 +199,17 @@ sign_colors)
     right=$(json_number "$json" right_sign_pct)
     holds "$right" 99 "a > b" || fail "right_sign_pct $right <= 99 with '$vp'"
   done
+  ;;
+bad_files)
+  [ $# -eq 2 ] || fail "bad_files needs DIR"
+  d="$2"
+  echo "hello world" >"$d/not_pcd_text.pcd" || fail "cannot write $d"
+  head -c 1000 /dev/zero >"$d/not_pcd_zeros.pcd"
+  head -c 4000 /bin/sh >"$d/not_pcd_binary.pcd"
+  ply_header='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n'
+  printf "${ply_header}0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n" >"$d/renamed_ply.pcd"
+  printf "${ply_header}0 0 0 0 0 1\n1 five 0 0 0 1\n0 1 0 0 0 1\n" >"$d/word.ply"
+  printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n0 0 0\n1 five 0\n0 1 0\n' >"$d/word.pcd"
   ;;
 truncate)
   [ $# -eq 4 ] || fail "truncate needs SRC DST BYTES"

@@ -19,6 +19,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -108,7 +109,9 @@ checkArguments(int argc,
     if (!a.empty() && a[0] == '-') {
       std::string best;
       std::size_t best_d = 3; /* suggest only close names */
-      const std::string bare = a.substr(a.find_first_not_of('-'));
+      const std::size_t first = a.find_first_not_of('-');
+      const std::string bare =
+          first == std::string::npos ? std::string() : a.substr(first);
       for (auto list : {switches, valued})
         for (const char* o : list) {
           const std::size_t d =
@@ -132,6 +135,282 @@ checkArguments(int argc,
   return true;
 }
 
+namespace detail {
+
+/** A whole token that strtod takes (numbers, nan, inf). */
+inline bool
+isNumber(const std::string& t)
+{
+  if (t.empty())
+    return false;
+  char* end = nullptr;
+  errno = 0;
+  (void)std::strtod(t.c_str(), &end);
+  return end == t.c_str() + t.size();
+}
+
+inline std::vector<std::string>
+tokens(const std::string& line)
+{
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i])))
+      ++i;
+    std::size_t j = i;
+    while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j])))
+      ++j;
+    if (j > i)
+      out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+/** \a s with bytes outside printable ASCII shown as '?' (for messages). */
+inline std::string
+printable(std::string s)
+{
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126)
+      c = '?';
+  return s;
+}
+
+/** Reads one '\n'-terminated line (without it); false at end of file. */
+inline bool
+readLine(std::FILE* f, std::string& line, std::size_t max_len = 1 << 20)
+{
+  line.clear();
+  int c;
+  while ((c = std::fgetc(f)) != EOF) {
+    if (c == '\n')
+      return true;
+    if (line.size() < max_len)
+      line.push_back(static_cast<char>(c));
+  }
+  return !line.empty();
+}
+
+inline bool
+parseCount(const std::string& t, unsigned long long& v)
+{
+  if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos ||
+      t.size() > 19)
+    return false;
+  v = std::strtoull(t.c_str(), nullptr, 10);
+  return true;
+}
+
+/** The PCD header and, for ASCII data, every value: PCL 1.13's reader
+ *  crashes on files that are not PCD and turns words into NaN. */
+inline bool
+checkPcd(std::FILE* f, long long file_size, const std::string& path, std::string& error)
+{
+  std::string line;
+  std::vector<std::string> fields, size, type, count;
+  unsigned long long width = 0, height = 0, points = 0;
+  bool have_width = false, have_height = false, have_points = false;
+  std::string data;
+  std::size_t lineno = 0;
+  auto bad = [&](const std::string& what) {
+    error = "'" + path + "' is not a valid PCD file: line " + std::to_string(lineno) +
+            ": " + printable(what);
+    return false;
+  };
+  while (data.empty()) {
+    if (!readLine(f, line, 4096))
+      return bad("the header ends before its DATA line");
+    ++lineno;
+    if (line.find('\0') != std::string::npos)
+      return bad("binary bytes in the header");
+    const std::vector<std::string> t = tokens(line);
+    if (t.empty() || t[0][0] == '#')
+      continue;
+    const std::string& key = t[0];
+    const std::vector<std::string> rest(t.begin() + 1, t.end());
+    if (key == "VERSION" || key == "VIEWPOINT")
+      continue;
+    else if (key == "FIELDS" || key == "COLUMNS")
+      fields = rest;
+    else if (key == "SIZE")
+      size = rest;
+    else if (key == "TYPE")
+      type = rest;
+    else if (key == "COUNT")
+      count = rest;
+    else if (key == "WIDTH" && rest.size() == 1 && parseCount(rest[0], width))
+      have_width = true;
+    else if (key == "HEIGHT" && rest.size() == 1 && parseCount(rest[0], height))
+      have_height = true;
+    else if (key == "POINTS" && rest.size() == 1 && parseCount(rest[0], points))
+      have_points = true;
+    else if (key == "DATA" && rest.size() == 1)
+      data = rest[0];
+    else
+      return bad("unexpected '" + line.substr(0, 60) + "'");
+  }
+  if (fields.empty() || size.size() != fields.size() || type.size() != fields.size())
+    return bad("FIELDS, SIZE and TYPE must list the same number of entries");
+  if (count.empty())
+    count.assign(fields.size(), "1");
+  if (count.size() != fields.size())
+    return bad("COUNT must list one entry per field");
+  unsigned long long point_size = 0, values = 0;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    unsigned long long sz = 0, c = 0;
+    if (!parseCount(size[i], sz) || (sz != 1 && sz != 2 && sz != 4 && sz != 8))
+      return bad("SIZE of field '" + fields[i] + "' must be 1, 2, 4 or 8");
+    if (type[i] != "F" && type[i] != "I" && type[i] != "U")
+      return bad("TYPE of field '" + fields[i] + "' must be F, I or U");
+    if (!parseCount(count[i], c) || c == 0 || c > 100000)
+      return bad("COUNT of field '" + fields[i] + "' must be a positive integer");
+    point_size += sz * c;
+    values += c;
+  }
+  if (!have_width || !have_points)
+    return bad("WIDTH and POINTS are required");
+  if (!have_height)
+    height = 1;
+  if (width > (1ull << 40) || height > (1ull << 40) || width * height != points)
+    return bad("WIDTH x HEIGHT differs from POINTS");
+  const long long header_end = std::ftell(f);
+  if (data == "binary") {
+    if (points > 0 &&
+        (unsigned long long)(file_size - header_end) < points * point_size)
+      return bad("binary data is truncated: " + std::to_string(points) + " points of " +
+                 std::to_string(point_size) + " bytes need " +
+                 std::to_string(points * point_size) + " bytes, the file holds " +
+                 std::to_string(file_size - header_end));
+  }
+  else if (data == "binary_compressed") {
+    unsigned char sizes[8];
+    if (points > 0 && std::fread(sizes, 1, 8, f) != 8)
+      return bad("compressed data is missing");
+    if (points > 0) {
+      const unsigned long long packed = sizes[0] | sizes[1] << 8 | sizes[2] << 16 |
+                                        (unsigned long long)sizes[3] << 24;
+      const unsigned long long unpacked = sizes[4] | sizes[5] << 8 | sizes[6] << 16 |
+                                          (unsigned long long)sizes[7] << 24;
+      if (unpacked != points * point_size)
+        return bad("compressed data holds " + std::to_string(unpacked) +
+                   " bytes, the header needs " + std::to_string(points * point_size));
+      if ((unsigned long long)(file_size - header_end - 8) < packed)
+        return bad("compressed data is truncated");
+    }
+  }
+  else if (data == "ascii") {
+    for (unsigned long long p = 0; p < points; ++p) {
+      if (!readLine(f, line))
+        return bad("ASCII data is truncated: it ends after " + std::to_string(p) +
+                   " of " + std::to_string(points) + " points");
+      ++lineno;
+      const std::vector<std::string> t = tokens(line);
+      if (t.size() != values)
+        return bad("expected " + std::to_string(values) + " values, found " +
+                   std::to_string(t.size()));
+      for (const std::string& v : t)
+        if (!isNumber(v))
+          return bad("'" + v.substr(0, 40) + "' is not a number");
+    }
+  }
+  else
+    return bad("DATA must be ascii, binary or binary_compressed, got '" + data + "'");
+  return true;
+}
+
+/** ASCII PLY: every value of every element line must be a number (PCL 1.13
+ *  turns words into NaN). Binary PLY is left to PCL's reader. */
+inline bool
+checkPly(std::FILE* f, const std::string& path, std::string& error)
+{
+  std::string line;
+  std::size_t lineno = 0;
+  auto bad = [&](const std::string& what) {
+    error = "'" + path + "' is not a valid PLY file: line " + std::to_string(lineno) +
+            ": " + printable(what);
+    return false;
+  };
+  struct Element {
+    unsigned long long count;
+    std::vector<bool> is_list;
+  };
+  std::vector<Element> elements;
+  std::string format;
+  if (!readLine(f, line, 64) ||
+      (++lineno, tokens(line) != std::vector<std::string>{"ply"}))
+    return bad("the file does not start with 'ply'");
+  for (;;) {
+    if (!readLine(f, line, 4096))
+      return bad("the header ends before 'end_header'");
+    ++lineno;
+    const std::vector<std::string> t = tokens(line);
+    if (t.empty())
+      continue;
+    if (t[0] == "end_header")
+      break;
+    if (t[0] == "format" && t.size() >= 2)
+      format = t[1];
+    else if (t[0] == "element" && t.size() == 3) {
+      Element e{0, {}};
+      if (!parseCount(t[2], e.count))
+        return bad("element count '" + t[2] + "' is not a count");
+      elements.push_back(e);
+    }
+    else if (t[0] == "property" && t.size() >= 3) {
+      if (elements.empty())
+        return bad("a property before any element");
+      elements.back().is_list.push_back(t[1] == "list");
+    }
+  }
+  if (format != "ascii")
+    return true;
+  for (const Element& e : elements)
+    for (unsigned long long r = 0; r < e.count; ++r) {
+      if (!readLine(f, line))
+        return bad("the data ends early");
+      ++lineno;
+      const std::vector<std::string> t = tokens(line);
+      std::size_t k = 0;
+      for (bool list : e.is_list) {
+        unsigned long long n = 1;
+        if (list) {
+          if (k >= t.size() || !parseCount(t[k], n))
+            return bad("a list length is missing or not a count");
+          ++k;
+        }
+        for (unsigned long long j = 0; j < n; ++j, ++k) {
+          if (k >= t.size())
+            return bad("too few values");
+          if (!isNumber(t[k]))
+            return bad("'" + t[k].substr(0, 40) + "' is not a number");
+        }
+      }
+      if (k != t.size())
+        return bad("too many values");
+    }
+  return true;
+}
+
+} // namespace detail
+
+/** Checks the file's own structure before PCL parses it (see detail::checkPcd
+ *  and detail::checkPly). */
+inline bool
+checkCloudFile(const std::string& path, long long file_size, std::string& error)
+{
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) {
+    error = "cannot open '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  const bool ok = extension(path) == ".pcd"
+                      ? detail::checkPcd(f, file_size, path, error)
+                      : detail::checkPly(f, path, error);
+  std::fclose(f);
+  return ok;
+}
+
 /** Loads a .pcd or .ply into \a cloud and checks it is complete and has x, y, z.
  *  On failure returns false with a message in \a error. */
 inline bool
@@ -151,6 +430,9 @@ loadCloud2(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& err
     return false;
   }
   const std::string ext = extension(path);
+  if ((ext == ".pcd" || ext == ".ply") &&
+      !checkCloudFile(path, static_cast<long long>(st.st_size), error))
+    return false;
   int rc = -1;
   if (ext == ".pcd") {
     pcl::PCDReader reader;
