@@ -35,6 +35,12 @@
 #       binary named .pcd, a PLY renamed to .pcd, ASCII PCD and PLY with a word
 #       among the numbers (PCL 1.13 crashes on the first kind and reads words
 #       as NaN).
+#   check_cli.sh full_disk ORIENT EVAL box.ply DIR
+#       with the file size limited (ulimit -f 10 / 100, SIGXFSZ ignored: writes fail
+#       as on a full disk), pcl_dacpo_orient writing over its own input (.ply),
+#       over an existing .pcd, and with -edges / -mesh side outputs, and
+#       pcl_dacpo_eval -colored must exit 1 with "cannot write", leave every
+#       existing file byte for byte as it was and leave no temporary file.
 #   check_cli.sh truncate SRC DST BYTES
 #       writes the first BYTES bytes of SRC to DST (a truncated input).
 #   check_cli.sh empty DST
@@ -210,6 +216,37 @@ bad_files)
   printf "${ply_header}0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n" >"$d/renamed_ply.pcd"
   printf "${ply_header}0 0 0 0 0 1\n1 five 0 0 0 1\n0 1 0 0 0 1\n" >"$d/word.ply"
   printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n0 0 0\n1 five 0\n0 1 0\n' >"$d/word.pcd"
+  ;;
+full_disk)
+  [ $# -eq 5 ] || fail "full_disk needs ORIENT EVAL box.ply DIR"
+  d="$5/full_disk"
+  rm -rf "$d" && mkdir -p "$d" || fail "cannot make $d"
+  cp "$4" "$d/scan.ply" && cp "$4" "$d/keep.ply" || fail "cannot copy $4"
+  "$2" "$d/scan.ply" "$d/old.pcd" -q -no_ipsr 2>/dev/null || fail "cannot make old.pcd"
+  cp "$d/old.pcd" "$d/keep.pcd"
+  printf 'old edges\n' >"$d/old.csv"
+  printf 'old mesh\n' >"$d/old_mesh.ply"
+  # limited KB COMMAND...: run with files limited to KB kilobytes
+  limited() { bash -c 'trap "" XFSZ; ulimit -f "$0"; exec "$@"' "$@"; }
+  expect_write_error() {
+    err=$(limited "$@" 2>&1 >/dev/null)
+    rc=$?
+    [ $rc -eq 1 ] || fail "exit $rc, expected 1: $*"
+    echo "$err" | grep -q "cannot write" || fail "no 'cannot write' message: $* -> $err"
+  }
+  expect_write_error 100 "$2" "$d/scan.ply" "$d/scan.ply" -no_ipsr
+  cmp -s "$d/scan.ply" "$d/keep.ply" || fail "the input was changed by a failed write over it"
+  expect_write_error 10 "$2" "$d/scan.ply" "$d/old.pcd" -no_ipsr
+  cmp -s "$d/old.pcd" "$d/keep.pcd" || fail "old.pcd was changed by a failed write"
+  limited 100 "$2" "$d/scan.ply" "$d/small.pcd" -no_ipsr -edges "$d/old.csv" >/dev/null 2>&1
+  grep -qx "old edges" "$d/old.csv" || [ "$(head -1 "$d/old.csv")" = "block_a,block_b,alpha,alpha_bar,confidence,flipped_a,flipped_b" ] ||
+    fail "old.csv is neither the old file nor a complete new one"
+  expect_write_error 100 "$2" "$d/scan.ply" "$d/scan2.pcd" -mesh "$d/old_mesh.ply"
+  grep -qx "old mesh" "$d/old_mesh.ply" || fail "old_mesh.ply was changed by a failed write"
+  expect_write_error 10 "$3" "$d/scan.ply" "$d/keep.pcd" -colored "$d/old.pcd"
+  cmp -s "$d/old.pcd" "$d/keep.pcd" || fail "old.pcd was changed by a failed -colored write"
+  left=$(find "$d" -name '.*tmp*' | head -1)
+  [ -z "$left" ] || fail "temporary file left behind: $left"
   ;;
 truncate)
   [ $# -eq 4 ] || fail "truncate needs SRC DST BYTES"

@@ -22,8 +22,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace dacpo_tool {
@@ -710,32 +713,186 @@ normalsColored(const pcl::PCLPointCloud2& in)
   return out;
 }
 
-/** Writes binary-compressed PCD or binary PLY by extension. */
+/* ---- safe output -------------------------------------------------------
+ * A tool never leaves a half-written file, nor destroys the one it replaces
+ * (`pcl_dacpo_orient scan.ply scan.ply` on a full disk): every output goes to a
+ * temporary file in the target's folder, is checked, synced to disk and only
+ * then renamed over the target. PCL's writers do not report write errors (and
+ * its PCD writer maps the file, which dies with SIGBUS on a full disk), so PCD
+ * data is produced in memory and written here with every call checked, and
+ * PLY files written by PCL are read back and their size checked. */
+
+/** errno as text, with the path. */
+inline std::string
+ioError(const std::string& what, const std::string& path)
+{
+  return what + " '" + path + "': " + std::strerror(errno);
+}
+
+/** Writes \a bytes to \a path (created or truncated), checking every write,
+ *  fsync and close; messages name \a shown (the file the user asked for). */
+inline bool
+writeAllChecked(const std::string& path,
+                const std::string& bytes,
+                std::string& error,
+                const std::string& shown = std::string())
+{
+  const std::string& name = shown.empty() ? path : shown;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    error = ioError("cannot create", name);
+    return false;
+  }
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0 && errno == EINTR)
+      continue;
+    if (w <= 0) {
+      error = ioError("cannot write", name);
+      ::close(fd);
+      return false;
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (::fsync(fd) != 0) {
+    error = ioError("cannot sync", name);
+    ::close(fd);
+    return false;
+  }
+  if (::close(fd) != 0) {
+    error = ioError("cannot close", name);
+    return false;
+  }
+  return true;
+}
+
+/** fsync of a file written by someone else (PCL). */
+inline bool
+syncFile(const std::string& path, std::string& error)
+{
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    error = ioError("cannot reopen", path);
+    return false;
+  }
+  const bool ok = ::fsync(fd) == 0;
+  if (!ok)
+    error = ioError("cannot sync", path);
+  ::close(fd);
+  return ok;
+}
+
+/** Size a binary little-endian PLY must have: its header plus, per element,
+ *  count x record size (no list properties). 0 if that cannot be told. */
+inline long long
+expectedBinaryPlySize(const std::string& path)
+{
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f)
+    return 0;
+  std::string line;
+  unsigned long long total = 0, count = 0, record = 0;
+  bool binary = false, ok = true;
+  auto flush = [&] { total += count * record; };
+  while (detail::readLine(f, line, 4096)) {
+    const std::vector<std::string> t = detail::tokens(line);
+    if (t.empty())
+      continue;
+    if (t[0] == "format")
+      binary = t.size() >= 2 && t[1] == "binary_little_endian";
+    else if (t[0] == "element" && t.size() == 3) {
+      flush();
+      count = std::strtoull(t[2].c_str(), nullptr, 10);
+      record = 0;
+    }
+    else if (t[0] == "property" && t.size() == 3) {
+      static const char* const one[] = {"char", "uchar", "int8", "uint8"};
+      static const char* const two[] = {"short", "ushort", "int16", "uint16"};
+      static const char* const four[] = {
+          "int", "uint", "float", "int32", "uint32", "float32"};
+      static const char* const eight[] = {"double", "float64"};
+      auto is = [&](const char* const* list, std::size_t n) {
+        return std::any_of(list, list + n, [&](const char* x) { return t[1] == x; });
+      };
+      record += is(one, 4)     ? 1
+                : is(two, 4)   ? 2
+                : is(four, 6)  ? 4
+                : is(eight, 2) ? 8
+                               : 0;
+      ok = ok && (is(one, 4) || is(two, 4) || is(four, 6) || is(eight, 2));
+    }
+    else if (t[0] == "property")
+      ok = false; /* a list */
+    else if (t[0] == "end_header")
+      break;
+  }
+  flush();
+  const long long header = std::ftell(f);
+  std::fclose(f);
+  return binary && ok ? header + static_cast<long long>(total) : 0;
+}
+
+/** Produces \a path through a temporary file beside it: \a produce writes the
+ *  temporary file (given its name), then it is synced and renamed over \a path.
+ *  On any failure the temporary file is removed and \a path is untouched. */
+template <typename Produce>
+bool
+writeAtomically(const std::string& path, Produce produce, std::string& error)
+{
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir =
+      slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::string tmp = dir + "." + base + ".tmp" +
+                          std::to_string(static_cast<long>(::getpid())) +
+                          extension(path);
+  const bool ok = produce(tmp, error) && syncFile(tmp, error);
+  if (ok && std::rename(tmp.c_str(), path.c_str()) == 0)
+    return true;
+  if (ok)
+    error = ioError("cannot replace", path);
+  std::remove(tmp.c_str());
+  return false;
+}
+
+/** Writes binary-compressed PCD or binary PLY by extension, safely (above). */
 inline bool
 saveCloud2(const std::string& path,
            const pcl::PCLPointCloud2& cloud,
            std::string& error)
 {
   const std::string ext = extension(path);
-  int rc = -1;
-  if (ext == ".pcd") {
-    pcl::PCDWriter writer;
-    rc = writer.writeBinaryCompressed(path, cloud);
-  }
-  else if (ext == ".ply") {
-    pcl::PLYWriter writer;
-    rc = writer.writeBinary(
-        path, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), false);
-  }
-  else {
+  if (ext != ".pcd" && ext != ".ply") {
     error = "'" + path + "': unknown extension (use .pcd or .ply)";
     return false;
   }
-  if (rc < 0) {
-    error = "cannot write '" + path + "'";
-    return false;
-  }
-  return true;
+  return writeAtomically(
+      path,
+      [&](const std::string& tmp, std::string& err) {
+        if (ext == ".pcd") {
+          std::ostringstream os;
+          pcl::PCDWriter writer;
+          if (writer.writeBinaryCompressed(os, cloud) < 0 || !os) {
+            err = "cannot encode '" + path + "' as PCD";
+            return false;
+          }
+          return writeAllChecked(tmp, os.str(), err, path);
+        }
+        pcl::PLYWriter writer;
+        const int rc = writer.writeBinary(
+            tmp, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), false);
+        struct stat st;
+        const long long want = expectedBinaryPlySize(tmp);
+        if (rc < 0 || ::stat(tmp.c_str(), &st) != 0 || want == 0 ||
+            st.st_size != want) {
+          err =
+              "cannot write '" + path + "' (short write: disk full or no permission?)";
+          return false;
+        }
+        return true;
+      },
+      error);
 }
 
 /** Strict parse of "-name value" as an unsigned integer; false + message on junk.

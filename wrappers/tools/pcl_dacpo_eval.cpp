@@ -339,7 +339,14 @@ saveColored(const std::string& path,
     p.b = wrong[i] ? 0 : 255;
   }
   out.is_dense = false;
-  return pcl::io::savePCDFileBinaryCompressed(path, out) >= 0;
+  pcl::PCLPointCloud2 cloud;
+  pcl::toPCLPointCloud2(out, cloud);
+  std::string error;
+  if (!dacpo_tool::saveCloud2(path, cloud, error)) {
+    print_error("Error: %s\n", error.c_str());
+    return false;
+  }
+  return true;
 }
 
 } // namespace

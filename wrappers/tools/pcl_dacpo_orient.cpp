@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -475,28 +476,31 @@ saveEdges(const std::string& filename, const Result& r)
 {
   highlight("Saving ");
   value("%s ", filename.c_str());
-  FILE* f = std::fopen(filename.c_str(), "w");
-  if (!f) {
-    info("\n");
-    print_error(
-        "Error: cannot write '%s': %s\n", filename.c_str(), std::strerror(errno));
-    return false;
+  std::ostringstream csv;
+  csv << "block_a,block_b,alpha,alpha_bar,confidence,flipped_a,flipped_b\n";
+  char row[256];
+  for (const dacpo_edge_info& e : r.edges) {
+    std::snprintf(row,
+                  sizeof(row),
+                  "%d,%d,%.9g,%.9g,%.9g,%d,%d\n",
+                  static_cast<int>(e.block_a),
+                  static_cast<int>(e.block_b),
+                  e.alpha,
+                  e.alpha_bar,
+                  e.confidence,
+                  blockFlipped(r, e.block_a) ? 1 : 0,
+                  blockFlipped(r, e.block_b) ? 1 : 0);
+    csv << row;
   }
-  std::fprintf(f, "block_a,block_b,alpha,alpha_bar,confidence,flipped_a,flipped_b\n");
-  for (const dacpo_edge_info& e : r.edges)
-    std::fprintf(f,
-                 "%d,%d,%.9g,%.9g,%.9g,%d,%d\n",
-                 static_cast<int>(e.block_a),
-                 static_cast<int>(e.block_b),
-                 e.alpha,
-                 e.alpha_bar,
-                 e.confidence,
-                 blockFlipped(r, e.block_a) ? 1 : 0,
-                 blockFlipped(r, e.block_b) ? 1 : 0);
-  const bool ok = !std::ferror(f);
-  if (std::fclose(f) != 0 || !ok) {
+  std::string error;
+  if (!dacpo_tool::writeAtomically(
+          filename,
+          [&](const std::string& tmp, std::string& err) {
+            return dacpo_tool::writeAllChecked(tmp, csv.str(), err, filename);
+          },
+          error)) {
     info("\n");
-    print_error("Error: cannot write '%s'\n", filename.c_str());
+    print_error("Error: %s\n", error.c_str());
     return false;
   }
   info("[done : ");
@@ -637,8 +641,25 @@ saveMesh(const std::string& filename, const Result& r)
         static_cast<pcl::index_t>(r.mesh_triangles[3 * t]),
         static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 1]),
         static_cast<pcl::index_t>(r.mesh_triangles[3 * t + 2])};
-  if (pcl::io::savePLYFileBinary(filename, mesh) < 0) {
-    print_error("Error: cannot write the mesh to '%s'\n", filename.c_str());
+  std::string error;
+  if (!dacpo_tool::writeAtomically(
+          filename,
+          [&](const std::string& tmp, std::string& err) {
+            /* PCL does not report short writes: read the file back */
+            pcl::PolygonMesh back;
+            if (pcl::io::savePLYFileBinary(tmp, mesh) < 0 ||
+                pcl::io::loadPLYFile(tmp, back) < 0 ||
+                back.polygons.size() != mesh.polygons.size() ||
+                static_cast<std::size_t>(back.cloud.width) * back.cloud.height !=
+                    vertices.size()) {
+              err = "cannot write the mesh to '" + filename +
+                    "' (short write: disk full or no permission?)";
+              return false;
+            }
+            return true;
+          },
+          error)) {
+    print_error("Error: %s\n", error.c_str());
     return false;
   }
   info("Saved mesh ");
