@@ -214,6 +214,7 @@ bad_files)
   head -c 4000 /bin/sh >"$d/not_pcd_binary.pcd"
   ply_header='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n'
   printf "${ply_header}0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n" >"$d/renamed_ply.pcd"
+  cp "$d/renamed_ply.pcd" "$d/renamed_ply.ply"
   printf "${ply_header}0 0 0 0 0 1\n1 five 0 0 0 1\n0 1 0 0 0 1\n" >"$d/word.ply"
   printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n0 0 0\n1 five 0\n0 1 0\n' >"$d/word.pcd"
   ;;

@@ -899,6 +899,13 @@ main(int argc, char** argv)
   Result result;
   if (!compute(cloud, options, output, result))
     return 1;
+  if (!options.mesh.empty() && result.mesh_triangles.empty()) {
+    print_error("Error: no surface mesh for '%s': its %zu points are too few or too sparse "
+                "for a Poisson surface (blocks need at least 32 points); nothing written\n",
+                files[0].c_str(),
+                result.points);
+    return 1;
+  }
   if (!saveCloud(files[1], output))
     return 1;
   if (!options.edges.empty() && !saveEdges(options.edges, result))
