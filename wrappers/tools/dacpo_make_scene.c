@@ -4,7 +4,11 @@
  * little-endian PLY (float x y z nx ny nz). Plain C, needs only dacpo_support.
  *
  *   dacpo_make_scene out.ply [-scene room] [-n 100000] [-noise 0] [-downsample 0]
- *                            [-seed 1]
+ *                            [-seed 1] [-offset X,Y,Z] [-scale S]
+ *
+ * -offset moves the scene and -scale scales it (x S, then + offset); both write
+ * double x y z (georeferenced scans: in float, an offset of 5e6 m leaves a
+ * 0.5 m grid; 1e22 or 1e-23 m scenes test the range of the search).
  *
  * Exit status: 0 on success, 1 for bad arguments, 2 when generation or writing
  * fails.
@@ -19,6 +23,36 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+/* Binary little-endian PLY with double x y z (x scale + offset) and float
+ * normals. */
+static int
+write_ply_offset(const char* path,
+                 const dacpo_scene* sc,
+                 double scale,
+                 const double off[3],
+                 const char* tag)
+{
+  FILE* f = fopen(path, "wb");
+  if (!f)
+    return -1;
+  fprintf(f,
+          "ply\nformat binary_little_endian 1.0\ncomment %s\nelement vertex %zu\n"
+          "property double x\nproperty double y\nproperty double z\n"
+          "property float nx\nproperty float ny\nproperty float nz\nend_header\n",
+          tag,
+          sc->n);
+  for (size_t i = 0; i < sc->n; ++i) {
+    double p[3];
+    for (int d = 0; d < 3; ++d)
+      p[d] = scale * (double)sc->xyz[3 * i + d] + off[d];
+    if (fwrite(p, sizeof(double), 3, f) != 3 ||
+        fwrite(sc->normals + 3 * i, sizeof(float), 3, f) != 3)
+      break;
+  }
+  const int bad = ferror(f);
+  return fclose(f) != 0 || bad ? -1 : 0;
+}
 
 static void
 print_help(const char* prog)
@@ -45,6 +79,10 @@ print_help(const char* prog)
       d.downsample_to);
   printf("  -seed S          random seed (default: %llu)\n",
          (unsigned long long)d.seed);
+  printf("  -offset X,Y,Z    add this offset and write double x y z (as georeferenced\n"
+         "                   scans do), e.g. 4.5e5,5.4e6,120 (default: none, float)\n");
+  printf("  -scale S         multiply the coordinates by S (before -offset) and write\n"
+         "                   double x y z (default: none)\n");
   printf("  -h, --help       this text\n\n");
   printf("Example: %s room.ply -scene room -n 200000 -noise 0.004\n", prog);
 }
@@ -112,6 +150,8 @@ main(int argc, char** argv)
 {
   const char* prog = argc > 0 && argv[0] ? argv[0] : "dacpo_make_scene";
   const char* out_path = NULL;
+  double offset[3] = {0.0, 0.0, 0.0}, scale = 1.0;
+  int use_offset = 0;
   dacpo_scene_params p;
   dacpo_scene scene;
   char err[512];
@@ -132,7 +172,8 @@ main(int argc, char** argv)
     }
     if (a[0] == '-' && a[1] != '\0') {
       if (strcmp(a, "-scene") && strcmp(a, "-n") && strcmp(a, "-noise") &&
-          strcmp(a, "-downsample") && strcmp(a, "-seed"))
+          strcmp(a, "-downsample") && strcmp(a, "-seed") && strcmp(a, "-offset") &&
+          strcmp(a, "-scale"))
         return usage_error(prog, "unknown option", a);
       if (!v)
         return usage_error(prog, "missing value after", a);
@@ -155,6 +196,21 @@ main(int argc, char** argv)
       else if (strcmp(a, "-seed") == 0) {
         if (parse_u64(v, &p.seed) != 0)
           return usage_error(prog, "-seed needs an integer >= 0, got", v);
+      }
+      else if (strcmp(a, "-offset") == 0) {
+        char tail = 0;
+        if (sscanf(v, "%lf,%lf,%lf%c", &offset[0], &offset[1], &offset[2], &tail) !=
+                3 ||
+            !isfinite(offset[0]) || !isfinite(offset[1]) || !isfinite(offset[2]))
+          return usage_error(prog, "-offset needs three finite numbers X,Y,Z, got", v);
+        use_offset = 1;
+      }
+      else if (strcmp(a, "-scale") == 0) {
+        char* end = NULL;
+        scale = strtod(v, &end);
+        if (end == v || *end != '\0' || !isfinite(scale) || !(scale > 0.0))
+          return usage_error(prog, "-scale needs a finite number > 0, got", v);
+        use_offset = 1;
       }
       ++i;
       continue;
@@ -189,9 +245,20 @@ main(int argc, char** argv)
            p.noise_sigma,
            p.downsample_to,
            (unsigned long long)p.seed);
-  if (dacpo_ply_write(
-          out_path, scene.xyz, scene.normals, scene.n, comment, err, sizeof(err)) !=
-      0) {
+  if (use_offset ? write_ply_offset(out_path,
+                                    &scene,
+                                    scale,
+                                    offset,
+                                    "moved (dacpo_make_scene -scale/-offset)") != 0
+                 : dacpo_ply_write(out_path,
+                                   scene.xyz,
+                                   scene.normals,
+                                   scene.n,
+                                   comment,
+                                   err,
+                                   sizeof(err)) != 0) {
+    if (use_offset)
+      snprintf(err, sizeof(err), "cannot write '%s': %s", out_path, strerror(errno));
     fprintf(stderr, "%s: %s\n", prog, err);
     dacpo_scene_free(&scene);
     return 2;

@@ -526,23 +526,61 @@ readValue(const std::uint8_t* p, std::uint8_t datatype)
   }
 }
 
-/** Reads three named fields of every point into packed floats (3 per point). */
-inline std::vector<float>
+/** Reads three named fields of every point into packed values (3 per point),
+ *  float by default; readTriplet<double> keeps double input exact. */
+template <typename T = float>
+inline std::vector<T>
 readTriplet(const pcl::PCLPointCloud2& cloud,
             const char* a,
             const char* b,
             const char* c)
 {
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  std::vector<float> out(3 * n);
+  std::vector<T> out(3 * n);
   const char* names[3] = {a, b, c};
   for (int f = 0; f < 3; ++f) {
     const pcl::PCLPointField& field = cloud.fields[pcl::getFieldIndex(cloud, names[f])];
     for (std::size_t i = 0; i < n; ++i)
-      out[3 * i + f] = static_cast<float>(
+      out[3 * i + f] = static_cast<T>(
           readValue(&cloud.data[i * cloud.point_step + field.offset], field.datatype));
   }
   return out;
+}
+
+/** A local frame for float work: the centre of the finite points' bounding box
+ *  and its largest side (1 when the points are all equal or none is finite).
+ *  Georeferenced scans (offsets of 1e5-1e7 m) keep a 0.5 m grid in float, and
+ *  squared distances of huge or tiny clouds leave float's range. */
+struct LocalFrame {
+  double centre[3] = {0.0, 0.0, 0.0};
+  double scale = 1.0;
+};
+
+inline LocalFrame
+localFrame(const std::vector<double>& xyz)
+{
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    if (!std::isfinite(xyz[i]) || !std::isfinite(xyz[i + 1]) ||
+        !std::isfinite(xyz[i + 2]))
+      continue;
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], xyz[i + d]);
+      hi[d] = std::max(hi[d], xyz[i + d]);
+    }
+  }
+  LocalFrame f;
+  if (!(lo[0] <= hi[0]))
+    return f;
+  double side = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    f.centre[d] = 0.5 * lo[d] + 0.5 * hi[d];
+    side = std::max(side, hi[d] - lo[d]);
+  }
+  if (side > 0.0 && std::isfinite(side))
+    f.scale = side;
+  return f;
 }
 
 /** Copy of \a in without the named fields (data repacked). */

@@ -435,15 +435,22 @@ main(int argc, char** argv)
       return 1;
     }
   }
-  /* Same order? A reordered prediction would give a meaningless score. */
-  const std::vector<float> pxyz = dacpo_tool::readTriplet(pred2, "x", "y", "z");
+  /* Same order? A reordered prediction would give a meaningless score. In
+   * double: georeferenced files differ in float by the grid of their offset. */
+  const std::vector<double> xyzd = dacpo_tool::readTriplet<double>(gt2, "x", "y", "z");
+  const std::vector<double> pxyz =
+      dacpo_tool::readTriplet<double>(pred2, "x", "y", "z");
   double max_offset = 0.0, extent = 0.0;
   for (std::size_t i = 0; i < 3 * n; ++i) {
     if (std::isfinite(pxyz[i]))
-      max_offset =
-          std::max(max_offset, static_cast<double>(std::fabs(pxyz[i] - xyz[i])));
-    extent = std::max(extent, static_cast<double>(std::fabs(xyz[i])));
+      max_offset = std::max(max_offset, std::fabs(pxyz[i] - xyzd[i]));
+    extent = std::max(extent, std::fabs(xyzd[i]));
   }
+  /* the k-NN components in a local frame (float search) */
+  const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(xyzd);
+  std::vector<float> local(3 * n);
+  for (std::size_t i = 0; i < 3 * n; ++i)
+    local[i] = static_cast<float>((xyzd[i] - frame.centre[i % 3]) / frame.scale);
   if (max_offset > 1e-4 * std::max(1.0, extent))
     print_warn(stderr,
                "Warning: predicted positions differ from the ground truth by up to "
@@ -455,7 +462,7 @@ main(int argc, char** argv)
       dacpo_score_oriented(gt.data(), pred.data(), n, nullptr, &wrong_all);
 
   std::vector<std::int32_t> label;
-  const std::size_t components = componentLabels(xyz, label);
+  const std::size_t components = componentLabels(local, label);
   std::vector<std::size_t> sizes(components, 0);
   for (std::int32_t l : label)
     ++sizes[l];

@@ -321,18 +321,30 @@ compute(const pcl::PCLPointCloud2& input,
 {
   const std::size_t n = static_cast<std::size_t>(input.width) * input.height;
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
-  const std::vector<float> coords = dacpo_tool::readTriplet(input, "x", "y", "z");
+  const std::vector<double> coords =
+      dacpo_tool::readTriplet<double>(input, "x", "y", "z");
+  /* A local frame, in double: centred on the bounding box and scaled by its
+   * largest side. Orientation does not depend on position or scale, but float
+   * does: georeferenced scans (offsets of 1e5-1e7 m) keep a 0.5 m grid in
+   * float, and squared distances of huge or tiny clouds leave float's range
+   * in the neighbour search. The output keeps the input's own coordinates. */
+  const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(coords);
   /* Unorganized on purpose: PCL would pick OrganizedNeighbor for an organized
    * cloud, which needs a projective sensor. The output keeps the input's
    * width x height. */
   xyz->resize(n);
   xyz->is_dense = false;
   for (std::size_t i = 0; i < n; ++i)
-    (*xyz)[i].getVector3fMap() << coords[3 * i], coords[3 * i + 1], coords[3 * i + 2];
+    for (int d = 0; d < 3; ++d)
+      (*xyz)[i].data[d] =
+          static_cast<float>((coords[3 * i + d] - frame.centre[d]) / frame.scale);
 
   pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
   dacpo.setInputCloud(xyz);
-  dacpo.setParameters(options.params);
+  dacpo_params params = options.params;
+  for (int d = 0; d < 3; ++d) /* -vp is given in the input's frame */
+    params.viewpoint[d] = (params.viewpoint[d] - frame.centre[d]) / frame.scale;
+  dacpo.setParameters(params);
 
   const bool has_normals =
       dacpo_tool::hasFields(input, {"normal_x", "normal_y", "normal_z"});
@@ -418,6 +430,10 @@ compute(const pcl::PCLPointCloud2& input,
   result.flips = dacpo.getBlockFlips();
   result.edges = dacpo.getEdges();
   result.mesh_vertices = dacpo.getMeshVertices();
+  for (std::size_t i = 0; i < result.mesh_vertices.size();
+       ++i) /* back to the input frame */
+    result.mesh_vertices[i] =
+        static_cast<float>(result.mesh_vertices[i] * frame.scale + frame.centre[i % 3]);
   result.mesh_triangles = dacpo.getMeshTriangles();
 
   /* Keep every input field except the ones we write, then append ours. */
@@ -900,10 +916,11 @@ main(int argc, char** argv)
   if (!compute(cloud, options, output, result))
     return 1;
   if (!options.mesh.empty() && result.mesh_triangles.empty()) {
-    print_error("Error: no surface mesh for '%s': its %zu points are too few or too sparse "
-                "for a Poisson surface (blocks need at least 32 points); nothing written\n",
-                files[0].c_str(),
-                result.points);
+    print_error(
+        "Error: no surface mesh for '%s': its %zu points are too few or too sparse "
+        "for a Poisson surface (blocks need at least 32 points); nothing written\n",
+        files[0].c_str(),
+        result.points);
     return 1;
   }
   if (!saveCloud(files[1], output))
