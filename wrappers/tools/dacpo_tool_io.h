@@ -548,9 +548,12 @@ readTriplet(const pcl::PCLPointCloud2& cloud,
 }
 
 /** A local frame for float work: the centre of the finite points' bounding box
- *  and its largest side (1 when the points are all equal or none is finite).
- *  Georeferenced scans (offsets of 1e5-1e7 m) keep a 0.5 m grid in float, and
- *  squared distances of huge or tiny clouds leave float's range. */
+ *  and its largest side, used only when float is at risk: georeferenced scans
+ *  (offsets of 1e5-1e7 m keep a 0.5 m grid in float) and clouds whose squared
+ *  distances leave float's range (sides above 1e6 or below 1e-6). Other
+ *  clouds keep the identity frame, so their results do not change with it
+ *  (measured: re-centring ordinary clouds moved rounding enough to redraw two
+ *  frames' seed lottery). */
 struct LocalFrame {
   double centre[3] = {0.0, 0.0, 0.0};
   double scale = 1.0;
@@ -573,13 +576,19 @@ localFrame(const std::vector<double>& xyz)
   LocalFrame f;
   if (!(lo[0] <= hi[0]))
     return f;
-  double side = 0.0;
+  double side = 0.0, far = 0.0, centre[3];
   for (int d = 0; d < 3; ++d) {
-    f.centre[d] = 0.5 * lo[d] + 0.5 * hi[d];
+    centre[d] = 0.5 * lo[d] + 0.5 * hi[d];
     side = std::max(side, hi[d] - lo[d]);
+    far = std::max(far, std::fabs(centre[d]));
   }
-  if (side > 0.0 && std::isfinite(side))
+  if (!(side > 0.0) || !std::isfinite(side))
+    return f;
+  if (far > 1e3 * side || side > 1e6 || side < 1e-6) {
+    for (int d = 0; d < 3; ++d)
+      f.centre[d] = centre[d];
     f.scale = side;
+  }
   return f;
 }
 

@@ -323,11 +323,10 @@ compute(const pcl::PCLPointCloud2& input,
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
   const std::vector<double> coords =
       dacpo_tool::readTriplet<double>(input, "x", "y", "z");
-  /* A local frame, in double: centred on the bounding box and scaled by its
-   * largest side. Orientation does not depend on position or scale, but float
-   * does: georeferenced scans (offsets of 1e5-1e7 m) keep a 0.5 m grid in
-   * float, and squared distances of huge or tiny clouds leave float's range
-   * in the neighbour search. The output keeps the input's own coordinates. */
+  /* Read in double and, where float is at risk (georeferenced offsets, huge
+   * or tiny clouds: dacpo_tool::localFrame), moved to a local frame:
+   * orientation does not depend on position or scale. The output keeps the
+   * input's own coordinates. */
   const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(coords);
   /* Unorganized on purpose: PCL would pick OrganizedNeighbor for an organized
    * cloud, which needs a projective sensor. The output keeps the input's
