@@ -10,6 +10,7 @@ PACKAGES=(
   lp-solve            # lp_solve shared library (/usr/lib/lp_solve/liblpsolve55.so, LGPL)
   libgtest-dev        # gtest
   pcl-tools           # pcl_viewer for looking at results
+  clang               # libFuzzer targets (scripts/fuzz.sh, part of the test command)
 )
 
 missing=()

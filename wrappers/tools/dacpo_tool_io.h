@@ -300,9 +300,18 @@ checkPcd(std::FILE* f, long long file_size, const std::string& path, std::string
                    " bytes, the header needs " + std::to_string(points * point_size));
       if ((unsigned long long)(file_size - header_end - 8) < packed)
         return bad("compressed data is truncated");
+      /* LZF expands at most ~100x: a larger claim is corrupt (and would be
+       * allocated before anything is read) */
+      if (unpacked > 128 * packed + 4096)
+        return bad("compressed data claims " + std::to_string(unpacked) +
+                   " bytes from " + std::to_string(packed));
     }
   }
   else if (data == "ascii") {
+    if (points >
+        (unsigned long long)std::max(0LL, file_size - header_end) / (2 * values))
+      return bad("the header claims " + std::to_string(points) +
+                 " points, more than the file's ASCII data can hold");
     for (unsigned long long p = 0; p < points; ++p) {
       if (!readLine(f, line))
         return bad("ASCII data is truncated: it ends after " + std::to_string(p) +
@@ -322,10 +331,36 @@ checkPcd(std::FILE* f, long long file_size, const std::string& path, std::string
   return true;
 }
 
-/** ASCII PLY: every value of every element line must be a number (PCL 1.13
- *  turns words into NaN). Binary PLY is left to PCL's reader. */
+/** Bytes of a PLY scalar type, 0 if unknown. */
+inline unsigned
+plyTypeSize(const std::string& t)
+{
+  static const char* const one[] = {"char", "uchar", "int8", "uint8"};
+  static const char* const two[] = {"short", "ushort", "int16", "uint16"};
+  static const char* const four[] = {
+      "int", "uint", "float", "int32", "uint32", "float32"};
+  static const char* const eight[] = {"double", "float64"};
+  for (const char* x : one)
+    if (t == x)
+      return 1;
+  for (const char* x : two)
+    if (t == x)
+      return 2;
+  for (const char* x : four)
+    if (t == x)
+      return 4;
+  for (const char* x : eight)
+    if (t == x)
+      return 8;
+  return 0;
+}
+
+/** PLY header sanity (format, property types, element counts the file can
+ *  hold: PCL 1.13 allocates what the header claims before reading, so a
+ *  corrupt count exhausted memory), and for ASCII PLY every value of every
+ *  element line must be a number (PCL 1.13 turns words into NaN). */
 inline bool
-checkPly(std::FILE* f, const std::string& path, std::string& error)
+checkPly(std::FILE* f, long long file_size, const std::string& path, std::string& error)
 {
   std::string line;
   std::size_t lineno = 0;
@@ -337,6 +372,7 @@ checkPly(std::FILE* f, const std::string& path, std::string& error)
   struct Element {
     unsigned long long count;
     std::vector<bool> is_list;
+    unsigned long long min_bytes; /* binary: smallest record */
   };
   std::vector<Element> elements;
   std::string format;
@@ -352,20 +388,50 @@ checkPly(std::FILE* f, const std::string& path, std::string& error)
       continue;
     if (t[0] == "end_header")
       break;
-    if (t[0] == "format" && t.size() >= 2)
+    if (t[0] == "format") {
+      if (t.size() != 3 || (t[1] != "ascii" && t[1] != "binary_little_endian" &&
+                            t[1] != "binary_big_endian"))
+        return bad("format must be ascii, binary_little_endian or binary_big_endian");
       format = t[1];
-    else if (t[0] == "element" && t.size() == 3) {
-      Element e{0, {}};
-      if (!parseCount(t[2], e.count))
-        return bad("element count '" + t[2] + "' is not a count");
+    }
+    else if (t[0] == "element") {
+      Element e{0, {}, 0};
+      if (t.size() != 3 || !parseCount(t[2], e.count))
+        return bad("'element NAME COUNT' expected");
       elements.push_back(e);
     }
-    else if (t[0] == "property" && t.size() >= 3) {
+    else if (t[0] == "property") {
       if (elements.empty())
         return bad("a property before any element");
-      elements.back().is_list.push_back(t[1] == "list");
+      const bool list = t.size() == 5 && t[1] == "list";
+      if (list ? (plyTypeSize(t[2]) == 0 || plyTypeSize(t[3]) == 0)
+               : (t.size() != 3 || plyTypeSize(t[1]) == 0))
+        return bad("unknown property '" + line.substr(0, 60) + "'");
+      elements.back().is_list.push_back(list);
+      elements.back().min_bytes += plyTypeSize(list ? t[2] : t[1]);
     }
+    else if (t[0] != "comment" && t[0] != "obj_info")
+      return bad("unexpected '" + line.substr(0, 60) + "'");
   }
+  if (format.empty())
+    return bad("no format line");
+  /* every record takes at least this many bytes: binary, its scalars (a list
+   * at least its length); ASCII, one character and a separator per value */
+  const long long data_bytes = file_size - std::ftell(f);
+  unsigned long long need = 0;
+  for (const Element& e : elements) {
+    const unsigned long long per = format == "ascii"
+                                       ? 2 * std::max<std::size_t>(1, e.is_list.size())
+                                       : e.min_bytes;
+    if (per > 0 &&
+        e.count > static_cast<unsigned long long>(std::max(0LL, data_bytes)) / per)
+      return bad("the header claims " + std::to_string(e.count) +
+                 " records, more than the file's " + std::to_string(data_bytes) +
+                 " data bytes can hold");
+    need += e.count * per;
+  }
+  if (need > static_cast<unsigned long long>(std::max(0LL, data_bytes)))
+    return bad("the data is shorter than the header says");
   if (format != "ascii")
     return true;
   for (const Element& e : elements)
@@ -409,7 +475,7 @@ checkCloudFile(const std::string& path, long long file_size, std::string& error)
   }
   const bool ok = extension(path) == ".pcd"
                       ? detail::checkPcd(f, file_size, path, error)
-                      : detail::checkPly(f, path, error);
+                      : detail::checkPly(f, file_size, path, error);
   std::fclose(f);
   return ok;
 }
