@@ -304,6 +304,22 @@ TEST(DACPONormalOrientation, RadiusSearchIsRejected)
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(out.width, 0u);
   EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_FALSE(dacpo.getLastError().empty());
+
+  // radius and k both set: PCL's initCompute rejects it before the class runs
+  dacpo.setKSearch(10);
+  dacpo.compute(out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(dacpo.getLastError().find("radius"), std::string::npos)
+      << dacpo.getLastError();
+
+  // a good run afterwards clears the verdict
+  dacpo.setRadiusSearch(0.0);
+  skipIPSR(dacpo);
+  dacpo.compute(out);
+  EXPECT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  EXPECT_TRUE(dacpo.getLastError().empty());
 }
 
 TEST(DACPONormalOrientation, EmptyCloudGivesEmptyOutput)
@@ -314,8 +330,11 @@ TEST(DACPONormalOrientation, EmptyCloudGivesEmptyOutput)
   dacpo.setInputCloud(empty);
   pcl::PointCloud<pcl::Normal> out;
   out.resize(5);
-  dacpo.compute(out); // PCL's initCompute rejects it
+  dacpo.compute(out); // PCL's initCompute rejects it; the class says why
   EXPECT_TRUE(out.empty());
+  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_EMPTY_INPUT);
+  EXPECT_NE(dacpo.getLastError().find("empty"), std::string::npos)
+      << dacpo.getLastError();
 
   // Only non-finite points: the wrapper reports EMPTY_INPUT.
   pcl::PointCloud<pcl::PointXYZ>::Ptr nan_only(new pcl::PointCloud<pcl::PointXYZ>);
@@ -543,7 +562,8 @@ TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
   // x [0, 2.5]): the floor and the x = 0 and y = 0 walls (29.5 of 47 m^2) face
   // away from it as they are, so the one sign that makes most normals face it
   // (29.5 / 47 = 63 % of the points) turns the whole box inside out
-  pcl::PointCloud<pcl::PointXYZ>::Ptr moved(new pcl::PointCloud<pcl::PointXYZ>(*scene.cloud));
+  pcl::PointCloud<pcl::PointXYZ>::Ptr moved(
+      new pcl::PointCloud<pcl::PointXYZ>(*scene.cloud));
   moved->sensor_origin_ = Eigen::Vector4f(-1000.0f, -1000.0f, -1000.0f, 1.0f);
   dacpo.setInputCloud(moved);
   dacpo.useSensorOriginAsViewPoint();

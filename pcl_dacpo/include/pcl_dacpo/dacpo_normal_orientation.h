@@ -259,7 +259,8 @@ public:
     return params_.ipsr_max_iterations;
   }
 
-  /** \brief Consistency measure of the block-graph edges (default dipole boundary). */
+  /** \brief Consistency measure of the block-graph edges (default
+   *  DACPO_WEIGHT_VCR, the paper's visible connected regions). */
   void
   setEdgeWeight(dacpo_edge_weight weight)
   {
@@ -407,7 +408,6 @@ public:
   {
     return params_.disconnected;
   }
-
 
   /** \brief VCR image side in pixels (default 400, as in the paper). */
   void
@@ -610,6 +610,11 @@ protected:
   /** \brief Orient the normals of the points of indices_ into \a output. */
   void
   computeFeature(PointCloudOut& output) override;
+
+  /** \brief PCL's own checks (input set, search parameters), with their verdict
+   *  in getLastStatus() / getLastError() too: compute() returns early on them. */
+  bool
+  initCompute() override;
 
 private:
   /** \brief Reads normal i of the held normals cloud: axis and curvature. */

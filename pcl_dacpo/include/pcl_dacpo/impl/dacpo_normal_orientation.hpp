@@ -215,6 +215,33 @@ DACPONormalOrientation<PointInT, PointOutT>::fail(PointCloudOut& output,
 }
 
 template <typename PointInT, typename PointOutT>
+bool
+DACPONormalOrientation<PointInT, PointOutT>::initCompute()
+{
+  last_status_ = DACPO_OK;
+  last_error_.clear();
+  std::memset(&stats_, 0, sizeof(stats_));
+  /* the cases PCL rejects before computeFeature(), named here */
+  std::string why;
+  if (!input_)
+    why = "no input cloud (setInputCloud)";
+  else if (input_->empty())
+    why = "the input cloud is empty";
+  else if (search_radius_ != 0.0 && k_ != 0)
+    why = "both a search radius and k are set; DACPO needs k only (setRadiusSearch(0))";
+  if (!why.empty() || !Feature<PointInT, PointOutT>::initCompute()) {
+    last_status_ =
+        input_ && input_->empty() ? DACPO_ERR_EMPTY_INPUT : DACPO_ERR_INVALID_ARGUMENT;
+    last_error_ = why.empty()
+                      ? "PCL's Feature::initCompute() rejected the input or the "
+                        "search parameters"
+                      : why;
+    return false;
+  }
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
 void
 DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& output)
 {
