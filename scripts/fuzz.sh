@@ -15,7 +15,7 @@ command -v clang >/dev/null && command -v clang++ >/dev/null ||
 
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDACPO_BUILD_FUZZERS=ON -DDACPO_BUILD_TESTS=OFF -DDACPO_BUILD_SAMPLES=OFF \
-  -DDACPO_BUILD_TOOLS=OFF >/dev/null
+  -DDACPO_BUILD_TOOLS=OFF -DDACPO_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$build" -j "$(nproc)" --target fuzz_orient fuzz_file_checks >/dev/null
 
 targets=(file_checks orient)

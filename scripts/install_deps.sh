@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev        # gtest
   pcl-tools           # pcl_viewer for looking at results
   clang               # libFuzzer targets (scripts/fuzz.sh, part of the test command)
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python package and its tests
 )
 
 missing=()

@@ -59,5 +59,15 @@ cc -std=c11 -o "$work/minimal_pc" "$doc/samples/c/orient_minimal.c" \
   $(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs dacpo) ||
   fail "compiling with pkg-config flags failed"
 "$work/minimal_pc" >"$work/minimal_pc.log" 2>&1 || fail "the pkg-config build does not run"
+# 4. the Python package, when it was built: importable from the prefix alone
+py="$prefix/lib/python3/dist-packages"
+if [ -d "$py/pcl_dacpo" ]; then
+  (cd "$work" && PYTHONPATH="$py" /usr/bin/python3 -c "
+import pcl_dacpo, numpy as np
+pts, gt = pcl_dacpo.make_scene('box', 3000)
+n, r = pcl_dacpo.orient(pts, ipsr_enabled=False)
+assert np.mean(np.einsum('ij,ij->i', n, gt) > 0) > 0.99, r
+") >"$work/python.log" 2>&1 || fail "the installed Python package fails: $(tail -5 "$work/python.log")"
+fi
 echo "package: installed, samples built out of tree, C++-only app built, pkg-config works"
 exit 0

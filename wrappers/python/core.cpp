@@ -1,0 +1,298 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// pcl_dacpo._core: the C API for Python (pybind11 + numpy). The public,
+// keyword-checked API lives in pcl_dacpo/__init__.py; this layer only moves
+// arrays in and out, fills dacpo_params from a dict of already-named fields,
+// releases the GIL while the core runs and turns Ctrl-C or a progress callback
+// returning False into a clean cancel.
+#include <dacpo/dacpo.h>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+extern "C" {
+#include "dacpo_scene.h"
+}
+
+namespace py = pybind11;
+
+namespace {
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+/* Every dacpo_params field by name: (name, C default) for Python's checks. */
+py::dict
+defaultParams()
+{
+  dacpo_params p;
+  dacpo_params_init(&p);
+  py::dict d;
+  d["k"] = p.k;
+  d["normal_k"] = p.normal_k;
+  d["num_blocks"] = p.num_blocks;
+  d["ring_hops"] = p.ring_hops;
+  d["dipole_c"] = p.dipole_c;
+  d["dipole_orders"] = p.dipole_orders;
+  d["dipole_neighbors"] = p.dipole_neighbors;
+  d["dipole_final_sweep"] = p.dipole_final_sweep;
+  d["ipsr_enabled"] = p.ipsr_enabled != 0;
+  d["ipsr_max_iterations"] = p.ipsr_max_iterations;
+  d["edge_weight"] = static_cast<int>(p.edge_weight);
+  d["solver_time_limit"] = p.solver_time_limit;
+  d["seed"] = p.seed;
+  d["num_threads"] = p.num_threads;
+  d["disconnected"] = static_cast<int>(p.disconnected);
+  d["dipole_noise_band"] = p.dipole_noise_band;
+  d["vcr_image_size"] = p.vcr_image_size;
+  d["vcr_views"] = p.vcr_views;
+  d["vcr_perspective"] = p.vcr_perspective != 0;
+  d["vcr_boundary_factor"] = p.vcr_boundary_factor != 0;
+  d["dipole_restarts"] = p.dipole_restarts;
+  d["weak_edge_fraction"] = p.weak_edge_fraction;
+  d["sign_policy"] = static_cast<int>(p.sign_policy);
+  d["viewpoint"] = py::make_tuple(p.viewpoint[0], p.viewpoint[1], p.viewpoint[2]);
+  return d;
+}
+
+template <typename T>
+T
+get(const py::dict& d, const char* name, T fallback)
+{
+  return d.contains(name) ? d[name].cast<T>() : fallback;
+}
+
+dacpo_params
+toParams(const py::dict& d)
+{
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.k = get<size_t>(d, "k", p.k);
+  p.normal_k = get<size_t>(d, "normal_k", p.normal_k);
+  p.num_blocks = get<size_t>(d, "num_blocks", p.num_blocks);
+  p.ring_hops = get<size_t>(d, "ring_hops", p.ring_hops);
+  p.dipole_c = get<double>(d, "dipole_c", p.dipole_c);
+  p.dipole_orders = get<size_t>(d, "dipole_orders", p.dipole_orders);
+  p.dipole_neighbors = get<size_t>(d, "dipole_neighbors", p.dipole_neighbors);
+  p.dipole_final_sweep = get<int>(d, "dipole_final_sweep", p.dipole_final_sweep);
+  p.ipsr_enabled = get<bool>(d, "ipsr_enabled", p.ipsr_enabled != 0) ? 1 : 0;
+  p.ipsr_max_iterations = get<size_t>(d, "ipsr_max_iterations", p.ipsr_max_iterations);
+  p.edge_weight =
+      static_cast<dacpo_edge_weight>(get<int>(d, "edge_weight", p.edge_weight));
+  p.solver_time_limit = get<double>(d, "solver_time_limit", p.solver_time_limit);
+  p.seed = get<uint64_t>(d, "seed", p.seed);
+  p.num_threads = get<unsigned>(d, "num_threads", p.num_threads);
+  p.disconnected = static_cast<dacpo_disconnected_policy>(
+      get<int>(d, "disconnected", p.disconnected));
+  p.dipole_noise_band = get<double>(d, "dipole_noise_band", p.dipole_noise_band);
+  p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
+  p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
+  p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;
+  p.vcr_boundary_factor =
+      get<bool>(d, "vcr_boundary_factor", p.vcr_boundary_factor != 0) ? 1 : 0;
+  p.dipole_restarts = get<size_t>(d, "dipole_restarts", p.dipole_restarts);
+  p.weak_edge_fraction = get<double>(d, "weak_edge_fraction", p.weak_edge_fraction);
+  p.sign_policy =
+      static_cast<dacpo_sign_policy>(get<int>(d, "sign_policy", p.sign_policy));
+  if (d.contains("viewpoint")) {
+    const py::tuple v = py::tuple(d["viewpoint"]);
+    for (int i = 0; i < 3; ++i)
+      p.viewpoint[i] = v[i].cast<double>();
+  }
+  p.estimate_normals = get<bool>(d, "estimate_normals", false) ? 1 : 0;
+  return p;
+}
+
+/* "" or the message naming the bad field. */
+std::string
+validate(const py::dict& d)
+{
+  const dacpo_params p = toParams(d);
+  char msg[256] = "";
+  return dacpo_params_validate(&p, msg, sizeof(msg)) == DACPO_OK ? std::string() : msg;
+}
+
+struct ProgressState {
+  py::object callback; /* None or callable(stage_name, fraction) -> bool */
+  bool cancelled_by_user = false;
+  bool interrupted = false;
+  py::error_already_set* error = nullptr;
+};
+
+/* Called by the core on the calling thread with the GIL released. */
+int
+progressHook(void* user, dacpo_stage stage, double fraction)
+{
+  auto* st = static_cast<ProgressState*>(user);
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() != 0) { /* Ctrl-C: KeyboardInterrupt is pending */
+    st->interrupted = true;
+    return 1;
+  }
+  if (st->callback.is_none())
+    return 0;
+  try {
+    const py::object r = st->callback(dacpo_stage_name(stage), fraction);
+    if (!r.is_none() && !r.cast<bool>()) {
+      st->cancelled_by_user = true;
+      return 1;
+    }
+  } catch (py::error_already_set& e) {
+    st->error = new py::error_already_set(std::move(e));
+    return 1;
+  }
+  return 0;
+}
+
+struct CtxDeleter {
+  void
+  operator()(dacpo_ctx* c) const
+  {
+    dacpo_ctx_free(c);
+  }
+};
+
+/* Returns a dict: status, message, and on success the arrays and stats. */
+py::dict
+orient(FloatArray points,
+       py::object normals_in,
+       const py::dict& params,
+       py::object progress)
+{
+  if (points.ndim() != 2 || points.shape(1) != 3)
+    throw py::value_error("points must have shape (N, 3)");
+  const size_t n = static_cast<size_t>(points.shape(0));
+  dacpo_params p = toParams(params);
+  py::array_t<float> normals(
+      {static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+  float* out = normals.mutable_data();
+  if (normals_in.is_none()) {
+    p.estimate_normals = 1;
+    std::memset(out, 0, 3 * n * sizeof(float));
+  }
+  else {
+    FloatArray given = normals_in.cast<FloatArray>();
+    if (given.ndim() != 2 || given.shape(0) != points.shape(0) || given.shape(1) != 3)
+      throw py::value_error("normals must have the shape of points, (N, 3)");
+    std::memcpy(out, given.data(), 3 * n * sizeof(float));
+  }
+
+  dacpo_ctx* raw = nullptr;
+  if (dacpo_ctx_create(&raw) != DACPO_OK)
+    throw std::bad_alloc();
+  std::unique_ptr<dacpo_ctx, CtxDeleter> ctx(raw);
+  ProgressState state;
+  state.callback = progress;
+  dacpo_progress hook{&progressHook, &state};
+  dacpo_status status;
+  {
+    py::gil_scoped_release release;
+    status = dacpo_orient(ctx.get(), &p, nullptr, &hook, points.data(), out, n);
+  }
+  if (state.error) {
+    py::error_already_set e = std::move(*state.error);
+    delete state.error;
+    throw e;
+  }
+  if (state.interrupted)
+    throw py::error_already_set(); /* the pending KeyboardInterrupt */
+
+  py::dict r;
+  r["status"] = static_cast<int>(status);
+  r["status_name"] = dacpo_status_string(status);
+  r["message"] = std::string(dacpo_ctx_last_error(ctx.get()));
+  r["cancelled_by_callback"] = state.cancelled_by_user;
+  if (status != DACPO_OK)
+    return r;
+  const dacpo_stats* s = dacpo_ctx_stats(ctx.get());
+  py::dict stats;
+  stats["input_points"] = s->input_points;
+  stats["unique_points"] = s->unique_points;
+  stats["duplicate_points"] = s->duplicate_points;
+  stats["k_used"] = s->k_used;
+  stats["num_components"] = s->num_components;
+  stats["num_blocks"] = s->num_blocks;
+  stats["num_block_edges"] = s->num_block_edges;
+  stats["flipped_blocks"] = s->flipped_blocks;
+  stats["solver_optimal"] = s->solver_optimal != 0;
+  stats["num_parts"] = s->num_parts;
+  stats["parts_related"] = s->parts_related;
+  stats["view_score"] = s->view_score;
+  stats["sign_flipped"] = s->sign_flipped != 0;
+  stats["sign_facing"] = s->sign_facing;
+  stats["sign_enclosed"] = s->sign_enclosed != 0;
+  stats["total_seconds"] = s->total_seconds;
+  py::dict stage_seconds;
+  for (int i = 0; i < DACPO_STAGE_COUNT; ++i)
+    stage_seconds[dacpo_stage_name(static_cast<dacpo_stage>(i))] = s->stage_seconds[i];
+  stats["stage_seconds"] = stage_seconds;
+  r["stats"] = stats;
+  r["normals"] = normals;
+  const size_t m = s->input_points;
+  auto copy_i32 = [&](const int32_t* src) {
+    py::array_t<int32_t> a(static_cast<py::ssize_t>(m));
+    if (src)
+      std::memcpy(a.mutable_data(), src, m * sizeof(int32_t));
+    return a;
+  };
+  r["component_labels"] = copy_i32(dacpo_ctx_point_components(ctx.get()));
+  r["block_labels"] = copy_i32(dacpo_ctx_point_blocks(ctx.get()));
+  py::array_t<float> conf(static_cast<py::ssize_t>(m));
+  if (const float* c = dacpo_ctx_point_confidence(ctx.get()))
+    std::memcpy(conf.mutable_data(), c, m * sizeof(float));
+  r["confidence"] = conf;
+  py::array_t<uint8_t> flips(static_cast<py::ssize_t>(s->num_blocks));
+  if (const uint8_t* f = dacpo_ctx_block_flips(ctx.get()))
+    std::memcpy(flips.mutable_data(), f, s->num_blocks);
+  r["block_flips"] = flips;
+  return r;
+}
+
+/* A generated scene with ground truth (tests/support/dacpo_scene.h). */
+py::tuple
+makeScene(const std::string& kind, size_t points, uint64_t seed, double noise)
+{
+  dacpo_scene_params sp;
+  dacpo_scene_params_init(&sp);
+  if (dacpo_scene_kind_from_name(kind.c_str(), &sp.kind) != 0)
+    throw py::value_error("unknown scene kind '" + kind + "'");
+  sp.target_points = points;
+  sp.seed = seed;
+  sp.noise_sigma = noise;
+  dacpo_scene s;
+  char err[256] = "";
+  if (dacpo_scene_generate(&sp, &s, err, sizeof(err)) != 0)
+    throw py::value_error(err);
+  py::array_t<float> xyz({static_cast<py::ssize_t>(s.n), static_cast<py::ssize_t>(3)});
+  py::array_t<float> nrm({static_cast<py::ssize_t>(s.n), static_cast<py::ssize_t>(3)});
+  std::memcpy(xyz.mutable_data(), s.xyz, 3 * s.n * sizeof(float));
+  std::memcpy(nrm.mutable_data(), s.normals, 3 * s.n * sizeof(float));
+  dacpo_scene_free(&s);
+  return py::make_tuple(xyz, nrm);
+}
+
+} // namespace
+
+PYBIND11_MODULE(_core, m)
+{
+  m.doc() = "pcl_dacpo's C core (use the pcl_dacpo package, not this module)";
+  m.def("default_params", &defaultParams);
+  m.def("validate", &validate);
+  m.def("orient",
+        &orient,
+        py::arg("points"),
+        py::arg("normals"),
+        py::arg("params"),
+        py::arg("progress"));
+  m.def("make_scene",
+        &makeScene,
+        py::arg("kind"),
+        py::arg("points"),
+        py::arg("seed"),
+        py::arg("noise"));
+  m.attr("version") = dacpo_version_string();
+}

@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: BSD-3-Clause
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class DacpoError(RuntimeError):
+    status: int
+    status_name: str
+    message: str
+    def __init__(self, status: int, status_name: str, message: str) -> None: ...
+
+class OrientResult:
+    stats: Dict[str, Any]
+    component_labels: npt.NDArray[np.int32]
+    block_labels: npt.NDArray[np.int32]
+    block_flips: npt.NDArray[np.uint8]
+    confidence: npt.NDArray[np.float32]
+    seconds: float
+
+def default_params() -> Dict[str, Any]: ...
+def orient(
+    points: npt.ArrayLike,
+    normals: Optional[npt.ArrayLike] = ...,
+    *,
+    progress: Optional[Callable[[str, float], Optional[bool]]] = ...,
+    k: int = ...,
+    normal_k: int = ...,
+    num_blocks: int = ...,
+    ring_hops: int = ...,
+    dipole_c: float = ...,
+    dipole_orders: int = ...,
+    dipole_neighbors: int = ...,
+    dipole_final_sweep: int = ...,
+    ipsr_enabled: bool = ...,
+    ipsr_max_iterations: int = ...,
+    edge_weight: Union[str, int] = ...,
+    solver_time_limit: float = ...,
+    seed: int = ...,
+    threads: int = ...,
+    num_threads: int = ...,
+    disconnected: Union[str, int] = ...,
+    dipole_noise_band: float = ...,
+    vcr_image_size: int = ...,
+    vcr_views: int = ...,
+    vcr_perspective: bool = ...,
+    vcr_boundary_factor: bool = ...,
+    dipole_restarts: int = ...,
+    weak_edge_fraction: float = ...,
+    sign_policy: Union[str, int] = ...,
+    viewpoint: Sequence[float] = ...,
+) -> Tuple[npt.NDArray[np.float32], OrientResult]: ...
+def orient_o3d(pcd: Any, **params: Any) -> OrientResult: ...
+def make_scene(
+    kind: str = ..., points: int = ..., *, seed: int = ..., noise: float = ...
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
