@@ -787,42 +787,65 @@ readFloatField(const pcl::PCLPointCloud2& cloud, const char* name)
   return out;
 }
 
-/** x y z rgb normal_x normal_y normal_z of a cloud with normals, every point
- *  coloured by its normal, RGB = (n + 1) / 2: pcl_viewer draws -normals as
- *  undirected segments, the colour shows the sign (+z = blue, -z = olive; a
- *  region facing the wrong way shows in the complementary colour). Points without a
- * finite normal are black. */
+/** A coloured copy of packed points for pcl_viewer: x y z rgb, plus
+ *  normal_x/y/z when \a normals is not empty; \a colour(i, rgb) paints point i. */
+template <typename Colour>
 inline pcl::PCLPointCloud2
-normalsColored(const pcl::PCLPointCloud2& in)
+colouredCloud(const std::vector<float>& xyz,
+              const std::vector<float>& normals,
+              Colour colour,
+              bool is_dense)
 {
-  const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
-  const std::vector<float> xyz = readTriplet(in, "x", "y", "z");
-  const std::vector<float> nrm = readTriplet(in, "normal_x", "normal_y", "normal_z");
+  const std::size_t n = xyz.size() / 3;
   pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
   cloud.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     pcl::PointXYZRGBNormal& p = cloud[i];
-    p.x = xyz[3 * i];
-    p.y = xyz[3 * i + 1];
-    p.z = xyz[3 * i + 2];
-    p.normal_x = nrm[3 * i];
-    p.normal_y = nrm[3 * i + 1];
-    p.normal_z = nrm[3 * i + 2];
-    const bool ok = std::isfinite(nrm[3 * i]) && std::isfinite(nrm[3 * i + 1]) &&
-                    std::isfinite(nrm[3 * i + 2]);
+    p.getVector3fMap() << xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2];
+    if (!normals.empty())
+      p.getNormalVector3fMap() << normals[3 * i], normals[3 * i + 1],
+          normals[3 * i + 2];
+    p.curvature = 0.0f;
     std::uint8_t rgb[3] = {0, 0, 0};
-    for (int d = 0; d < 3 && ok; ++d)
-      rgb[d] = static_cast<std::uint8_t>(
-          std::lround(127.5 * (1.0 + std::max(-1.0f, std::min(1.0f, nrm[3 * i + d])))));
+    colour(i, rgb);
     p.r = rgb[0];
     p.g = rgb[1];
     p.b = rgb[2];
   }
-  cloud.width = in.width;
-  cloud.height = in.height;
-  cloud.is_dense = in.is_dense;
+  cloud.is_dense = is_dense;
   pcl::PCLPointCloud2 out;
-  pcl::toPCLPointCloud2(cloud, out);
+  if (normals.empty()) {
+    pcl::PointCloud<pcl::PointXYZRGB> plain;
+    pcl::copyPointCloud(cloud, plain);
+    pcl::toPCLPointCloud2(plain, out);
+  }
+  else
+    pcl::toPCLPointCloud2(cloud, out);
+  return out;
+}
+
+/** x y z rgb normal_x normal_y normal_z of a cloud with normals, every point
+ *  coloured by its normal, RGB = (n + 1) / 2: pcl_viewer draws -normals as
+ *  undirected segments, the colour shows the sign (+z = blue, -z = olive; a
+ *  region facing the wrong way shows in the complementary colour). Points
+ *  without a finite normal are black. */
+inline pcl::PCLPointCloud2
+normalsColored(const pcl::PCLPointCloud2& in)
+{
+  const std::vector<float> nrm = readTriplet(in, "normal_x", "normal_y", "normal_z");
+  pcl::PCLPointCloud2 out = colouredCloud(
+      readTriplet(in, "x", "y", "z"),
+      nrm,
+      [&](std::size_t i, std::uint8_t rgb[3]) {
+        const float* v = &nrm[3 * i];
+        if (std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))
+          for (int d = 0; d < 3; ++d)
+            rgb[d] = static_cast<std::uint8_t>(
+                std::lround(127.5 * (1.0 + std::max(-1.0f, std::min(1.0f, v[d])))));
+      },
+      in.is_dense);
+  out.width = in.width;
+  out.height = in.height;
   return out;
 }
 

@@ -323,24 +323,14 @@ saveColored(const std::string& path,
             const std::vector<float>& normals,
             const std::vector<bool>& wrong)
 {
-  pcl::PointCloud<pcl::PointXYZRGBNormal> out;
-  out.resize(wrong.size());
-  for (std::size_t i = 0; i < wrong.size(); ++i) {
-    pcl::PointXYZRGBNormal& p = out[i];
-    p.x = xyz[3 * i];
-    p.y = xyz[3 * i + 1];
-    p.z = xyz[3 * i + 2];
-    p.normal_x = normals[3 * i];
-    p.normal_y = normals[3 * i + 1];
-    p.normal_z = normals[3 * i + 2];
-    p.curvature = 0.0f;
-    p.r = wrong[i] ? 255 : 0;
-    p.g = 0;
-    p.b = wrong[i] ? 0 : 255;
-  }
-  out.is_dense = false;
-  pcl::PCLPointCloud2 cloud;
-  pcl::toPCLPointCloud2(out, cloud);
+  const pcl::PCLPointCloud2 cloud = dacpo_tool::colouredCloud(
+      xyz,
+      normals,
+      [&](std::size_t i, std::uint8_t rgb[3]) {
+        rgb[0] = wrong[i] ? 255 : 0; /* red = wrong, blue = right */
+        rgb[2] = wrong[i] ? 0 : 255;
+      },
+      false);
   std::string error;
   if (!dacpo_tool::saveCloud2(path, cloud, error)) {
     print_error("Error: %s\n", error.c_str());

@@ -608,23 +608,13 @@ saveBlocksColored(const std::string& filename,
     print_error("Error: the run left no block labels\n");
     return false;
   }
-  const std::vector<float> xyz = dacpo_tool::readTriplet(input, "x", "y", "z");
-  pcl::PointCloud<pcl::PointXYZRGB> cloud;
-  cloud.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    pcl::PointXYZRGB& p = cloud[i];
-    p.x = xyz[3 * i];
-    p.y = xyz[3 * i + 1];
-    p.z = xyz[3 * i + 2];
-    std::uint8_t rgb[3];
-    blockColor(r.blocks[i], blockFlipped(r, r.blocks[i]), rgb);
-    p.r = rgb[0];
-    p.g = rgb[1];
-    p.b = rgb[2];
-  }
-  cloud.is_dense = input.is_dense;
-  pcl::PCLPointCloud2 cloud2;
-  pcl::toPCLPointCloud2(cloud, cloud2);
+  const pcl::PCLPointCloud2 cloud2 = dacpo_tool::colouredCloud(
+      dacpo_tool::readTriplet(input, "x", "y", "z"),
+      {},
+      [&](std::size_t i, std::uint8_t rgb[3]) {
+        blockColor(r.blocks[i], blockFlipped(r, r.blocks[i]), rgb);
+      },
+      input.is_dense);
   return saveCloud(filename, cloud2);
 }
 
