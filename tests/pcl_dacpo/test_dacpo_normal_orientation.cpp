@@ -590,3 +590,60 @@ TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
   EXPECT_EQ(dacpo.getStats().sign_flipped, 0);
   EXPECT_LT(wrongPercent(scene.gt, kept), kMaxWrongBox);
 }
+
+// An organized depth frame (64 x 48 pixels, a ball of radius 0.5 m in front of
+// a wall) seen from a sensor that was then moved (rotated and shifted, as
+// sensor_origin_ / sensor_orientation_ record it): useSensorOriginAsViewPoint()
+// makes the normals face the sensor; the default free-space sign agrees.
+TEST(DACPONormalOrientation, OrganizedFrameFacesItsSensorOrigin)
+{
+  const int W = 64, H = 48;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr frame(new pcl::PointCloud<pcl::PointXYZ>(W, H));
+  std::vector<float> gt(3 * W * H);
+  const Eigen::Vector3f centre(0.0f, 0.0f, -2.0f), shift(3.0f, -1.0f, 0.5f);
+  const Eigen::Matrix3f rot =
+      Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1.0f, 2.0f, 0.5f).normalized())
+          .toRotationMatrix();
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const Eigen::Vector3f ray =
+          Eigen::Vector3f((u - W / 2 + 0.5f) / 40.0f, (v - H / 2 + 0.5f) / 40.0f, -1.0f)
+              .normalized();
+      // ray-ball intersection, else the wall z = -3
+      const float b = ray.dot(centre), c = centre.squaredNorm() - 0.25f,
+                  disc = b * b - c;
+      Eigen::Vector3f p, n;
+      if (disc > 0.0f) {
+        p = ray * (b - std::sqrt(disc));
+        n = (p - centre).normalized();
+      }
+      else {
+        p = ray * (-3.0f / ray.z());
+        n = Eigen::Vector3f(0.0f, 0.0f, 1.0f);
+      }
+      const std::size_t i = static_cast<std::size_t>(v) * W + u;
+      (*frame)[i].getVector3fMap() = rot * p + shift;
+      const Eigen::Vector3f truth = rot * n;
+      for (int d = 0; d < 3; ++d)
+        gt[3 * i + d] = truth[d];
+    }
+  frame->sensor_origin_ << shift, 0.0f;
+  frame->sensor_orientation_ = Eigen::Quaternionf(rot);
+  ASSERT_TRUE(frame->isOrganized());
+
+  pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
+  skipIPSR(dacpo);
+  dacpo.setInputCloud(frame);
+  dacpo.useSensorOriginAsViewPoint();
+  pcl::PointCloud<pcl::Normal> out;
+  dacpo.compute(out);
+  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK) << dacpo.getLastError();
+  ASSERT_EQ(out.size(), frame->size());
+  EXPECT_EQ(out.width, static_cast<std::uint32_t>(W));
+  EXPECT_GT(rightAsGiven(gt, out), 99.0);
+  EXPECT_GT(dacpo.getStats().sign_facing, 0.99);
+
+  dacpo.setSignPolicy(DACPO_SIGN_FREE_SPACE);
+  dacpo.compute(out);
+  EXPECT_GT(rightAsGiven(gt, out), 99.0);
+}
