@@ -48,6 +48,10 @@
 #       other: <= 0.5 % differ, as the rounding of the move allows) and the output must keep the
 #       double coordinates; a sphere scaled by 1e22 and by 1e-23 must come out
 #       < 1 % wrong with outward normals.
+#   check_cli.sh batch ORIENT EVAL box.ply DIR
+#       -input_dir/-output_dir over a folder with two good files (.ply, .pcd) and
+#       one that is not a PCD: exit 1 naming the bad one, both good ones oriented
+#       (< 3 % wrong) under their own names; then the good ones alone: exit 0.
 #   check_cli.sh truncate SRC DST BYTES
 #       writes the first BYTES bytes of SRC to DST (a truncated input).
 #   check_cli.sh empty DST
@@ -282,6 +286,24 @@ same_normals)
     json=$("$4" "$d/sphere.ply" "$d/sphere_out.ply" -json 2>/dev/null) || fail "eval failed"
     holds "$(json_number "$json" right_sign_pct)" 99 "a > b" || fail "sphere x $s: $json"
   done
+  ;;
+batch)
+  [ $# -eq 5 ] || fail "batch needs ORIENT EVAL box.ply DIR"
+  d="$5/batch"
+  rm -rf "$d" && mkdir -p "$d/in" || fail "cannot make $d"
+  cp "$4" "$d/in/a.ply" && "$2" "$4" "$d/in/b.pcd" -q 2>/dev/null || fail "cannot make inputs"
+  echo "not a cloud" >"$d/in/c.pcd"
+  err=$("$2" -input_dir "$d/in" -output_dir "$d/out" -q -no_ipsr 2>&1 >/dev/null)
+  [ $? -eq 1 ] || fail "a failed file must give exit 1"
+  echo "$err" | grep -q "c.pcd' failed" || fail "the bad file is not named: $err"
+  for f in a.ply b.pcd; do
+    [ -f "$d/out/$f" ] || fail "$f was not written"
+    json=$("$3" "$4" "$d/out/$f" -json 2>/dev/null) || fail "eval of $f failed"
+    holds "$(json_number "$json" wrong_pct)" 3 "a < b" || fail "$f: $json"
+  done
+  rm "$d/in/c.pcd"
+  "$2" -input_dir "$d/in" -output_dir "$d/out2" -q -no_ipsr >/dev/null 2>&1 || fail "good batch failed"
+  [ -f "$d/out2/a.ply" ] && [ -f "$d/out2/b.pcd" ] || fail "good batch lost a file"
   ;;
 truncate)
   [ $# -eq 4 ] || fail "truncate needs SRC DST BYTES"

@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -70,11 +71,12 @@ struct Options {
   dacpo_params params;
   bool estimate = false;
   bool quiet = false;
-  bool labels = false;         /* -labels: block, component, flip fields */
-  std::string edges;           /* -edges file.csv */
-  std::string blocks_colored;  /* -blocks_colored file.{pcd,ply} */
-  std::string normals_colored; /* -normals_colored file.{pcd,ply} */
-  std::string mesh;            /* -mesh file.ply */
+  bool labels = false;               /* -labels: block, component, flip fields */
+  std::string edges;                 /* -edges file.csv */
+  std::string blocks_colored;        /* -blocks_colored file.{pcd,ply} */
+  std::string normals_colored;       /* -normals_colored file.{pcd,ply} */
+  std::string input_dir, output_dir; /* batch mode */
+  std::string mesh;                  /* -mesh file.ply */
 };
 
 /* What a run leaves for the diagnostics, in output (= input) point order. */
@@ -231,6 +233,11 @@ printHelp(int, char** argv)
       "                                   the normal's direction, RGB = (n + 1) / 2: "
       "a flipped\n"
       "                                   region shows in the complementary colour\n");
+  print_info(
+      "                     -input_dir D -output_dir O = batch: every .pcd/.ply "
+      "of D to the\n"
+      "                                   same name in O (created if missing); no "
+      "file arguments\n");
   print_info(
       "                     -q          = quiet: errors and the final stats line "
       "only\n");
@@ -807,6 +814,19 @@ parseOptions(int argc, char** argv, Options& o)
     }
     o.params.keep_mesh = 1;
   }
+  parse_argument(argc, argv, "-input_dir", o.input_dir);
+  parse_argument(argc, argv, "-output_dir", o.output_dir);
+  if (o.input_dir.empty() != o.output_dir.empty()) {
+    print_error("Error: -input_dir and -output_dir go together\n");
+    return false;
+  }
+  if (!o.input_dir.empty() && (!o.edges.empty() || !o.blocks_colored.empty() ||
+                               !o.mesh.empty() || !o.normals_colored.empty())) {
+    print_error(
+        "Error: -edges, -blocks_colored, -mesh and -normals_colored name one file: "
+        "not with -input_dir\n");
+    return false;
+  }
   for (const std::string* side : {&o.blocks_colored, &o.normals_colored}) {
     const std::string ext = dacpo_tool::extension(*side);
     if (!side->empty() && ext != ".pcd" && ext != ".ply") {
@@ -829,75 +849,16 @@ parseOptions(int argc, char** argv, Options& o)
 
 } // namespace
 
+/* One input to one output (and the side outputs), then the stats line;
+ * 0 on success, 1 on failure (the message is printed). */
 int
-main(int argc, char** argv)
+orientFile(const std::string& in, const std::string& out, const Options& options)
 {
-  const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
-  if (argc < 3 || help) {
-    print_info("Orient normals with DACPO. For more information, use: %s -h\n",
-               argv[0]);
-    printHelp(argc, argv);
-    return help ? 0 : 1;
-  }
-  {
-    std::string error;
-    if (!dacpo_tool::checkArguments(argc,
-                                    argv,
-                                    {"-estimate",
-                                     "-vcr_perspective",
-                                     "-vcr_c1c2",
-                                     "-no_ipsr",
-                                     "-separate",
-                                     "-bridge",
-                                     "-q",
-                                     "-labels"},
-                                    {"-k",
-                                     "-normal_k",
-                                     "-blocks",
-                                     "-ring",
-                                     "-c",
-                                     "-orders",
-                                     "-restarts",
-                                     "-band",
-                                     "-weak",
-                                     "-weights",
-                                     "-vcr_size",
-                                     "-vcr_views",
-                                     "-time_limit",
-                                     "-seed",
-                                     "-threads",
-                                     "-sign",
-                                     "-vp",
-                                     "-mesh",
-                                     "-edges",
-                                     "-blocks_colored",
-                                     "-normals_colored"},
-                                    error)) {
-      print_error("Error: %s\n", error.c_str());
-      return 1;
-    }
-  }
-  const std::vector<std::string> files = dacpo_tool::fileArguments(
-      argc, argv, {"-edges", "-blocks_colored", "-mesh", "-normals_colored"});
-  if (files.size() != 2) {
-    print_error("Need one input and one output file (.pcd or .ply), got %zu.\n",
-                files.size());
-    printHelp(argc, argv);
-    return 1;
-  }
-  Options options;
-  if (!parseOptions(argc, argv, options))
-    return 1;
-  if (options.quiet) {
-    g_verbose = false;
-    setVerbosityLevel(L_ERROR);
-  }
-
   pcl::PCLPointCloud2 cloud;
-  if (!loadCloud(files[0], cloud))
+  if (!loadCloud(in, cloud))
     return 1;
   if (cloud.width * cloud.height == 0) {
-    print_error("Error: '%s' has no points\n", files[0].c_str());
+    print_error("Error: '%s' has no points\n", in.c_str());
     return 1;
   }
   pcl::PCLPointCloud2 output;
@@ -908,11 +869,11 @@ main(int argc, char** argv)
     print_error(
         "Error: no surface mesh for '%s': its %zu points are too few or too sparse "
         "for a Poisson surface (blocks need at least 32 points); nothing written\n",
-        files[0].c_str(),
+        in.c_str(),
         result.points);
     return 1;
   }
-  if (!saveCloud(files[1], output))
+  if (!saveCloud(out, output))
     return 1;
   if (!options.edges.empty() && !saveEdges(options.edges, result))
     return 1;
@@ -957,4 +918,124 @@ main(int argc, char** argv)
                s.total_seconds,
                peakRssMb());
   return 0;
+}
+
+/* Batch mode, like pcl_normal_estimation: every .pcd/.ply of input_dir (in
+ * name order) to the same name in output_dir (created if missing). Goes on
+ * after a failed file; 1 if any failed. */
+int
+orientDirectory(const Options& options)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(options.input_dir, ec)) {
+    print_error("Error: -input_dir '%s' is not a directory\n",
+                options.input_dir.c_str());
+    return 1;
+  }
+  fs::create_directories(options.output_dir, ec);
+  if (ec || !fs::is_directory(options.output_dir)) {
+    print_error("Error: cannot create -output_dir '%s': %s\n",
+                options.output_dir.c_str(),
+                ec.message().c_str());
+    return 1;
+  }
+  std::vector<fs::path> inputs;
+  for (const fs::directory_entry& e : fs::directory_iterator(options.input_dir, ec)) {
+    const std::string ext = dacpo_tool::extension(e.path().string());
+    if (e.is_regular_file() && (ext == ".pcd" || ext == ".ply"))
+      inputs.push_back(e.path());
+  }
+  std::sort(inputs.begin(), inputs.end());
+  if (inputs.empty()) {
+    print_error("Error: no .pcd or .ply file in '%s'\n", options.input_dir.c_str());
+    return 1;
+  }
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const fs::path out = fs::path(options.output_dir) / inputs[i].filename();
+    info("[%zu/%zu] ", i + 1, inputs.size());
+    value("%s\n", inputs[i].filename().string().c_str());
+    if (orientFile(inputs[i].string(), out.string(), options) != 0) {
+      ++failed;
+      print_error("Error: '%s' failed, going on with the next file\n",
+                  inputs[i].string().c_str());
+    }
+  }
+  if (failed)
+    print_error("Error: %zu of %zu files failed\n", failed, inputs.size());
+  return failed ? 1 : 0;
+}
+
+int
+main(int argc, char** argv)
+{
+  const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  if (argc < 3 || help) {
+    print_info("Orient normals with DACPO. For more information, use: %s -h\n",
+               argv[0]);
+    printHelp(argc, argv);
+    return help ? 0 : 1;
+  }
+  {
+    std::string error;
+    if (!dacpo_tool::checkArguments(argc,
+                                    argv,
+                                    {"-estimate",
+                                     "-vcr_perspective",
+                                     "-vcr_c1c2",
+                                     "-no_ipsr",
+                                     "-separate",
+                                     "-bridge",
+                                     "-q",
+                                     "-labels"},
+                                    {"-k",
+                                     "-normal_k",
+                                     "-blocks",
+                                     "-ring",
+                                     "-c",
+                                     "-orders",
+                                     "-restarts",
+                                     "-band",
+                                     "-weak",
+                                     "-weights",
+                                     "-vcr_size",
+                                     "-vcr_views",
+                                     "-time_limit",
+                                     "-seed",
+                                     "-threads",
+                                     "-sign",
+                                     "-vp",
+                                     "-mesh",
+                                     "-edges",
+                                     "-blocks_colored",
+                                     "-normals_colored",
+                                     "-input_dir",
+                                     "-output_dir"},
+                                    error)) {
+      print_error("Error: %s\n", error.c_str());
+      return 1;
+    }
+  }
+  Options options;
+  if (!parseOptions(argc, argv, options))
+    return 1;
+  const std::vector<std::string> files = dacpo_tool::fileArguments(
+      argc, argv, {"-edges", "-blocks_colored", "-mesh", "-normals_colored"});
+  if (options.input_dir.empty() ? files.size() != 2 : !files.empty()) {
+    print_error(options.input_dir.empty()
+                    ? "Need one input and one output file (.pcd or .ply), got %zu.\n"
+                    : "With -input_dir/-output_dir give no file names, got %zu.\n",
+                files.size());
+    printHelp(argc, argv);
+    return 1;
+  }
+  if (options.quiet) {
+    g_verbose = false;
+    setVerbosityLevel(L_ERROR);
+  }
+
+  if (!options.input_dir.empty())
+    return orientDirectory(options);
+  return orientFile(files[0], files[1], options);
 }
