@@ -409,20 +409,6 @@ br_leafkey_cmp(const void* pa, const void* pb)
   return (a->leaf > b->leaf) - (a->leaf < b->leaf);
 }
 
-static int32_t
-br_find(int32_t* parent, int32_t c)
-{
-  int32_t root = c;
-  while (parent[root] != root)
-    root = parent[root];
-  while (parent[c] != root) {
-    int32_t next = parent[c];
-    parent[c] = root;
-    c = next;
-  }
-  return root;
-}
-
 /* ---- extra pairs near a tree edge ----------------------------------------- */
 
 static int
@@ -696,7 +682,7 @@ dacpo_bridge_components(const dacpo_cloud* cloud,
   size_t num_tree = 0, num_roots = C;
   for (int round = 0; num_roots > 1; ++round) {
     for (size_t i = 0; i < n; ++i)
-      plabel[i] = br_find(parent, component[tree.pts[i].id]);
+      plabel[i] = dacpo_uf_find(parent, component[tree.pts[i].id]);
     br_tree_label(&tree, plabel);
     size_t nr = 0;
     for (size_t c = 0; c < C; ++c) {
@@ -727,8 +713,8 @@ dacpo_bridge_components(const dacpo_cloud* cloud,
       const br_best* bb = &best[roots[k]];
       if (bb->a == INT32_MAX)
         continue;
-      int32_t ra = br_find(parent, component[bb->a]);
-      int32_t rb = br_find(parent, component[bb->b]);
+      int32_t ra = dacpo_uf_find(parent, component[bb->a]);
+      int32_t rb = dacpo_uf_find(parent, component[bb->b]);
       if (ra == rb)
         continue; /* the same edge, chosen from the other side */
       if (ra < rb)

@@ -47,9 +47,8 @@
  */
 #include "dacpo_ilp.h"
 
-#include <lp_lib.h>
-
 #include <limits.h>
+#include <lp_lib.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,15 +73,15 @@
  * ------------------------------------------------------------------------- */
 
 typedef struct ilp_graph {
-  size_t n;            /* nodes */
-  size_t m;            /* merged edges, ea < eb */
+  size_t n; /* nodes */
+  size_t m; /* merged edges, ea < eb */
   int32_t* ea;
   int32_t* eb;
-  double* c;           /* w_diff - w_same: what cutting the edge (y_e = 1) gains */
-  size_t* adj_start;   /* n + 1 */
-  int32_t* adj_node;   /* 2m, ascending within each node */
-  int32_t* adj_edge;   /* 2m, merged edge of each adjacency entry */
-  int32_t* comp;       /* component of each node */
+  double* c;         /* w_diff - w_same: what cutting the edge (y_e = 1) gains */
+  size_t* adj_start; /* n + 1 */
+  int32_t* adj_node; /* 2m, ascending within each node */
+  int32_t* adj_edge; /* 2m, merged edge of each adjacency entry */
+  int32_t* comp;     /* component of each node */
   size_t ncomp;
   size_t* comp_start;  /* ncomp + 1, into comp_nodes */
   int32_t* comp_nodes; /* ascending within a component: the lowest comes first */
@@ -287,16 +286,6 @@ ilp_key_desc(const void* pa, const void* pb)
   return (x->e > y->e) - (x->e < y->e);
 }
 
-static int32_t
-ilp_find(int32_t* parent, int32_t v)
-{
-  while (parent[v] != v) {
-    parent[v] = parent[parent[v]]; /* path halving */
-    v = parent[v];
-  }
-  return v;
-}
-
 /* The term of edge e in the gain of flipping one of its ends. */
 static double
 ilp_term(const ilp_graph* g, const uint8_t* o, int32_t e)
@@ -336,12 +325,12 @@ ilp_single_flips(const ilp_graph* g, uint8_t* o, double* gain, double tol)
 }
 
 typedef struct ilp_cluster_ws {
-  uint8_t* in_s;     /* node is in the cluster */
-  uint8_t* in_f;     /* node is on the frontier */
-  double* inner;     /* sum of terms of edges from the node into the cluster */
-  int32_t* members;  /* cluster in growth order */
+  uint8_t* in_s;    /* node is in the cluster */
+  uint8_t* in_f;    /* node is on the frontier */
+  double* inner;    /* sum of terms of edges from the node into the cluster */
+  int32_t* members; /* cluster in growth order */
   int32_t* frontier;
-  int32_t* touched;  /* nodes whose in_f / inner must be reset */
+  int32_t* touched; /* nodes whose in_f / inner must be reset */
 } ilp_cluster_ws;
 
 /* Grows a connected cluster from seed s, each step adding the frontier node
@@ -415,8 +404,8 @@ typedef struct ilp_tree {
   int32_t* parent; /* -1 at roots */
   int32_t* pedge;  /* edge to the parent, -1 at roots */
   int32_t* depth;
-  int32_t* lca;    /* per merged edge: lowest common ancestor of its ends */
-  double* acc;     /* scratch: subtree-gain accumulation */
+  int32_t* lca; /* per merged edge: lowest common ancestor of its ends */
+  double* acc;  /* scratch: subtree-gain accumulation */
 } ilp_tree;
 
 static void
@@ -471,10 +460,9 @@ ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
     uf[v] = (int32_t)v;
   for (size_t k = 0; k < m; ++k) {
     int32_t e = keys[k].e;
-    int32_t ra = ilp_find(uf, g->ea[e]), rb = ilp_find(uf, g->eb[e]);
-    if (ra == rb)
+    if (dacpo_uf_find(uf, g->ea[e]) == dacpo_uf_find(uf, g->eb[e]))
       continue;
-    uf[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    dacpo_uf_union(uf, g->ea[e], g->eb[e]);
     in_tree[e] = 1;
   }
   /* Iterative DFS preorder from each component's lowest node. */
@@ -558,7 +546,8 @@ done:
  * every subtree's gain in O(n + m); the best is flipped until none gains. This
  * undoes a noisy but confident edge that the spanning tree trusted. */
 static int
-ilp_subtree_moves(const ilp_graph* g, const ilp_tree* t, uint8_t* o, double* gain, double tol)
+ilp_subtree_moves(
+    const ilp_graph* g, const ilp_tree* t, uint8_t* o, double* gain, double tol)
 {
   int improved = 0;
   for (size_t it = 0; it < g->n; ++it) {
@@ -631,8 +620,8 @@ ilp_start(const ilp_graph* g,
 {
   for (size_t i = 0; i < g->n; ++i) {
     int32_t v = t->order[i];
-    o[v] = t->parent[v] < 0 ? 0
-                            : (uint8_t)(o[t->parent[v]] ^ (g->c[t->pedge[v]] > 0.0));
+    o[v] =
+        t->parent[v] < 0 ? 0 : (uint8_t)(o[t->parent[v]] ^ (g->c[t->pedge[v]] > 0.0));
   }
   memset(gain, 0, g->n * sizeof(double));
   for (size_t k = 0; k < g->m; ++k) {
@@ -665,8 +654,8 @@ ilp_heuristic(const ilp_graph* g, double stop_time, uint8_t* o, dacpo_err* err)
   w.members = dacpo_malloc_array(n, sizeof(int32_t));
   w.frontier = dacpo_malloc_array(n, sizeof(int32_t));
   w.touched = dacpo_malloc_array(n, sizeof(int32_t));
-  if (!gain || !o2 || !best || !w.in_s || !w.in_f || !w.inner || !w.members || !w.frontier ||
-      !w.touched) {
+  if (!gain || !o2 || !best || !w.in_s || !w.in_f || !w.inner || !w.members ||
+      !w.frontier || !w.touched) {
     st = DACPO_OOM(err);
     goto done;
   }
@@ -760,12 +749,12 @@ ilp_abort_cb(lprec* lp, void* user)
 
 /* Per-solve scratch, sized for the whole graph once. */
 typedef struct ilp_lp_ws {
-  int32_t* loc;   /* node -> local index in its component */
-  int32_t* ecol;  /* merged edge -> local edge index in its component */
-  double* vars;   /* lp_solve variables */
+  int32_t* loc;  /* node -> local index in its component */
+  int32_t* ecol; /* merged edge -> local edge index in its component */
+  double* vars;  /* lp_solve variables */
   /* odd-cycle separation on the doubled graph (2 copies of each node) */
   double* dist;
-  int32_t* pred;  /* predecessor adjacency entry * 2 + parity of the predecessor */
+  int32_t* pred; /* predecessor adjacency entry * 2 + parity of the predecessor */
   int32_t* heap;
   int32_t* heap_pos;
   uint8_t* mark;
@@ -778,7 +767,8 @@ typedef struct ilp_lp_ws {
 /* Adds one row. add_constraintex may reorder the arrays it is given, so the
  * caller refills them before every call. */
 static int
-ilp_add_row(lprec* lp, int count, double* row, int* col, int type, double rhs, size_t* rows)
+ilp_add_row(
+    lprec* lp, int count, double* row, int* col, int type, double rhs, size_t* rows)
 {
   if (!add_constraintex(lp, count, row, col, type, rhs))
     return 0;
@@ -792,8 +782,7 @@ ilp_add_xor_rows(lprec* lp, int ye, int ca, int cb, size_t* rows)
 {
   double r[3];
   int c[3];
-  static const double sign[4][3] = {
-      {1, -1, 1}, {1, 1, -1}, {1, -1, -1}, {1, 1, 1}};
+  static const double sign[4][3] = {{1, -1, 1}, {1, 1, -1}, {1, -1, -1}, {1, 1, 1}};
   static const int type[4] = {GE, GE, LE, LE};
   static const double rhs[4] = {0, 0, 0, 2};
   /* y >= o_a - o_b, y >= o_b - o_a, y <= o_a + o_b, y <= 2 - o_a - o_b */
@@ -1180,7 +1169,8 @@ ilp_lp_component(const ilp_graph* g,
   result->constraints += rows;
   delete_lp(lp);
   if (ab->cancelled)
-    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+    return dacpo_err_set(
+        err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
   return DACPO_OK;
 }
 
@@ -1198,25 +1188,45 @@ ilp_check(size_t num_nodes,
           dacpo_err* err)
 {
   DACPO_CHECK(err, result != NULL, DACPO_ERR_INVALID_ARGUMENT, "ilp: NULL result");
-  DACPO_CHECK(err, num_nodes == 0 || flip_out != NULL, DACPO_ERR_INVALID_ARGUMENT,
-              "ilp: NULL flip_out for %zu nodes", num_nodes);
-  DACPO_CHECK(err, num_edges == 0 || edges != NULL, DACPO_ERR_INVALID_ARGUMENT,
-              "ilp: NULL edges for %zu edges", num_edges);
-  DACPO_CHECK(err, num_nodes <= (size_t)INT32_MAX / 4 && num_edges <= (size_t)INT32_MAX / 4,
-              DACPO_ERR_INVALID_ARGUMENT, "ilp: %zu nodes / %zu edges exceed int32 indices",
-              num_nodes, num_edges);
-  DACPO_CHECK(err, time_limit > 0.0, DACPO_ERR_INVALID_ARGUMENT,
-              "ilp: time_limit must be > 0 (got %g)", time_limit);
+  DACPO_CHECK(err,
+              num_nodes == 0 || flip_out != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: NULL flip_out for %zu nodes",
+              num_nodes);
+  DACPO_CHECK(err,
+              num_edges == 0 || edges != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: NULL edges for %zu edges",
+              num_edges);
+  DACPO_CHECK(err,
+              num_nodes <= (size_t)INT32_MAX / 4 && num_edges <= (size_t)INT32_MAX / 4,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: %zu nodes / %zu edges exceed int32 indices",
+              num_nodes,
+              num_edges);
+  DACPO_CHECK(err,
+              time_limit > 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "ilp: time_limit must be > 0 (got %g)",
+              time_limit);
   for (size_t i = 0; i < num_edges; ++i) {
     const dacpo_ilp_edge* e = &edges[i];
-    DACPO_CHECK(err, e->a >= 0 && (size_t)e->a < num_nodes && e->b >= 0 &&
-                         (size_t)e->b < num_nodes,
+    DACPO_CHECK(err,
+                e->a >= 0 && (size_t)e->a < num_nodes && e->b >= 0 &&
+                    (size_t)e->b < num_nodes,
                 DACPO_ERR_INVALID_ARGUMENT,
-                "ilp: edge %zu joins nodes %ld and %ld, outside [0, %zu)", i, (long)e->a,
-                (long)e->b, num_nodes);
-    DACPO_CHECK(err, isfinite(e->w_same) && isfinite(e->w_diff),
-                DACPO_ERR_INVALID_ARGUMENT, "ilp: edge %zu has weights %g / %g", i,
-                e->w_same, e->w_diff);
+                "ilp: edge %zu joins nodes %ld and %ld, outside [0, %zu)",
+                i,
+                (long)e->a,
+                (long)e->b,
+                num_nodes);
+    DACPO_CHECK(err,
+                isfinite(e->w_same) && isfinite(e->w_diff),
+                DACPO_ERR_INVALID_ARGUMENT,
+                "ilp: edge %zu has weights %g / %g",
+                i,
+                e->w_same,
+                e->w_diff);
   }
   return DACPO_OK;
 }
@@ -1243,7 +1253,8 @@ dacpo_ilp_solve(size_t num_nodes,
   memset(result, 0, sizeof(*result));
   result->optimal = 1;
   if (ilp_progress(progress, 0.0))
-    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+    return dacpo_err_set(
+        err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
 
   ilp_graph g;
   DACPO_TRY(ilp_graph_build(num_nodes, num_edges, edges, &g, err));
@@ -1298,7 +1309,8 @@ dacpo_ilp_solve(size_t num_nodes,
       continue; /* nothing is frustrated: the incumbent reaches the bound */
     ab.fraction = (double)g.comp_start[ci] / (double)num_nodes;
     if (ilp_progress(progress, ab.fraction)) {
-      st = dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+      st = dacpo_err_set(
+          err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
       goto done;
     }
     if (!(ab.deadline - dacpo_now() > 0.0)) {
@@ -1324,7 +1336,8 @@ dacpo_ilp_solve(size_t num_nodes,
       result->optimal = 0;
   }
   if (ilp_progress(progress, 1.0)) {
-    st = dacpo_err_set(err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+    st = dacpo_err_set(
+        err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
     goto done;
   }
 

@@ -23,20 +23,21 @@ dacpo_err_set(dacpo_err* err, dacpo_status code, const char* fmt, ...)
 #endif
     ;
 
-#define DACPO_CHECK(err, cond, code, ...)                                      \
-  do {                                                                         \
-    if (!(cond))                                                               \
-      return dacpo_err_set((err), (code), __VA_ARGS__);                        \
+#define DACPO_CHECK(err, cond, code, ...)                                              \
+  do {                                                                                 \
+    if (!(cond))                                                                       \
+      return dacpo_err_set((err), (code), __VA_ARGS__);                                \
   } while (0)
 
-#define DACPO_TRY(expr)                                                        \
-  do {                                                                         \
-    dacpo_status dacpo_try_status_ = (expr);                                   \
-    if (dacpo_try_status_ != DACPO_OK)                                         \
-      return dacpo_try_status_;                                                \
+#define DACPO_TRY(expr)                                                                \
+  do {                                                                                 \
+    dacpo_status dacpo_try_status_ = (expr);                                           \
+    if (dacpo_try_status_ != DACPO_OK)                                                 \
+      return dacpo_try_status_;                                                        \
   } while (0)
 
-#define DACPO_OOM(err) dacpo_err_set((err), DACPO_ERR_OUT_OF_MEMORY, "out of memory in %s", __func__)
+#define DACPO_OOM(err)                                                                 \
+  dacpo_err_set((err), DACPO_ERR_OUT_OF_MEMORY, "out of memory in %s", __func__)
 
 /* Small deterministic RNG (splitmix64 seeding + xoshiro256**). Each block gets
  * its own stream from (seed, block id), so results do not depend on threads. */
@@ -77,5 +78,31 @@ void*
 dacpo_malloc_array(size_t count, size_t size);
 void*
 dacpo_calloc_array(size_t count, size_t size);
+
+/* Union-find over int32 ids (parent[i] == i for a root), shared by the stages
+ * that group things: VCR pixel regions, bridges between components, the 0-1
+ * program's spanning forest, parts of the block graph. Find halves paths; union
+ * makes the smaller root the root, so a root precedes its members in scan order
+ * and one scan can hand out compact ids. */
+static inline int32_t
+dacpo_uf_find(int32_t* parent, int32_t x)
+{
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+static inline void
+dacpo_uf_union(int32_t* parent, int32_t x, int32_t y)
+{
+  x = dacpo_uf_find(parent, x);
+  y = dacpo_uf_find(parent, y);
+  if (x < y)
+    parent[y] = x;
+  else if (y < x)
+    parent[x] = y;
+}
 
 #endif /* DACPO_INTERNAL_H */

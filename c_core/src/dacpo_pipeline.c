@@ -10,7 +10,6 @@
  * normals are written only after everything succeeded. */
 #include "dacpo_block_graph.h"
 #include "dacpo_bridge.h"
-#include "dacpo_part_sign.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
 #include "dacpo_global_sign.h"
@@ -20,6 +19,7 @@
 #include "dacpo_knn.h"
 #include "dacpo_normals.h"
 #include "dacpo_parallel.h"
+#include "dacpo_part_sign.h"
 #include "dacpo_segment.h"
 #include "dacpo_vcr.h"
 
@@ -41,22 +41,23 @@ typedef struct run_state {
   int32_t* input_component; /* component of the k-NN graph, as reported */
   size_t num_components;
   int32_t largest_component_id; /* input component with the most points */
-  float* curvature; /* per distinct point, only when estimated */
+  float* curvature;             /* per distinct point, only when estimated */
   dacpo_blocks blocks;
   dacpo_block_graph bgraph;
-  double* oriented;        /* 3n: normals after stages 2-3, before flips */
-  float* point_conf;       /* n: in-block confidence (stage 2, halved where stage 3 disagreed) */
-  double* ring_oriented;   /* 3 per ring entry: each block's normals of its ring */
-  dacpo_mesh* meshes;      /* per block, only for VCR weights */
-  dacpo_ipsr_stats* ipsr;  /* per block */
-  double* block_seconds;   /* per block: [2b] dipole, [2b+1] iPSR */
-  uint8_t* flips;          /* per block */
-  float* block_conf;       /* per block: how firmly stage 5 holds its flip */
-  double evidence_scale;   /* median alpha + alpha-bar of the block edges (stage 5) */
-  int32_t* part;           /* n: part of each point (VIEWPOINT policy) */
-  int8_t* part_sign;       /* per part */
-  double* part_conf;       /* per part */
-  double global_sign;      /* +1 or -1: stage 6 */
+  double* oriented; /* 3n: normals after stages 2-3, before flips */
+  float*
+      point_conf; /* n: in-block confidence (stage 2, halved where stage 3 disagreed) */
+  double* ring_oriented;  /* 3 per ring entry: each block's normals of its ring */
+  dacpo_mesh* meshes;     /* per block, only for VCR weights */
+  dacpo_ipsr_stats* ipsr; /* per block */
+  double* block_seconds;  /* per block: [2b] dipole, [2b+1] iPSR */
+  uint8_t* flips;         /* per block */
+  float* block_conf;      /* per block: how firmly stage 5 holds its flip */
+  double evidence_scale;  /* median alpha + alpha-bar of the block edges (stage 5) */
+  int32_t* part;          /* n: part of each point (VIEWPOINT policy) */
+  int8_t* part_sign;      /* per part */
+  double* part_conf;      /* per part */
+  double global_sign;     /* +1 or -1: stage 6 */
   dacpo_ilp_result ilp;
 } run_state;
 
@@ -91,8 +92,11 @@ run_state_free(run_state* s)
 static dacpo_status
 report(const run_state* s, dacpo_stage stage, double fraction, dacpo_err* err)
 {
-  if (s->progress && s->progress->fn && s->progress->fn(s->progress->user, stage, fraction) != 0)
-    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "cancelled by the progress callback during %s",
+  if (s->progress && s->progress->fn &&
+      s->progress->fn(s->progress->user, stage, fraction) != 0)
+    return dacpo_err_set(err,
+                         DACPO_ERR_CANCELLED,
+                         "cancelled by the progress callback during %s",
                          dacpo_stage_name(stage));
   return DACPO_OK;
 }
@@ -100,13 +104,20 @@ report(const run_state* s, dacpo_stage stage, double fraction, dacpo_err* err)
 /* ---- stage 0 ----------------------------------------------------------- */
 
 static dacpo_status
-build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo_err* err)
+build_neighbors(run_state* s,
+                dacpo_stats* st,
+                const dacpo_search* search,
+                dacpo_err* err)
 {
   const size_t n = s->cloud.n;
   const size_t min_points = s->p.estimate_normals ? 3 : 2;
-  DACPO_CHECK(err, n >= min_points, DACPO_ERR_TOO_FEW_POINTS,
-              "%zu distinct point(s) among %zu given; at least %zu are needed%s", n,
-              s->cloud.input_count, min_points,
+  DACPO_CHECK(err,
+              n >= min_points,
+              DACPO_ERR_TOO_FEW_POINTS,
+              "%zu distinct point(s) among %zu given; at least %zu are needed%s",
+              n,
+              s->cloud.input_count,
+              min_points,
               s->p.estimate_normals ? " to estimate normals" : "");
   st->k_used = s->p.k < n - 1 ? s->p.k : n - 1;
   st->k_clamped = st->k_used != s->p.k;
@@ -116,7 +127,8 @@ build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo
     if (nk > kmax)
       kmax = nk;
   }
-  DACPO_TRY(dacpo_knn_build(&s->cloud, kmax, search, s->p.num_threads, s->progress, &s->knn, err));
+  DACPO_TRY(dacpo_knn_build(
+      &s->cloud, kmax, search, s->p.num_threads, s->progress, &s->knn, err));
   DACPO_TRY(dacpo_adjacency_build(&s->knn, st->k_used, &s->adj, err));
   s->component = dacpo_malloc_array(n, sizeof(int32_t));
   if (!s->component)
@@ -135,11 +147,16 @@ build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo
       s->largest_component_id = (int32_t)c;
     }
   free(sizes);
-  DACPO_CHECK(err, s->num_components == 1 || s->p.disconnected != DACPO_DISCONNECTED_ERROR,
-              DACPO_ERR_DISCONNECTED,
-              "the k-NN graph (k=%zu) has %zu connected components (largest: %zu of %zu "
-              "points); their relative orientation is undefined",
-              st->k_used, s->num_components, st->largest_component, n);
+  DACPO_CHECK(
+      err,
+      s->num_components == 1 || s->p.disconnected != DACPO_DISCONNECTED_ERROR,
+      DACPO_ERR_DISCONNECTED,
+      "the k-NN graph (k=%zu) has %zu connected components (largest: %zu of %zu "
+      "points); their relative orientation is undefined",
+      st->k_used,
+      s->num_components,
+      st->largest_component,
+      n);
   s->input_component = dacpo_malloc_array(n, sizeof(int32_t));
   if (!s->input_component)
     return DACPO_OOM(err);
@@ -148,8 +165,14 @@ build_neighbors(run_state* s, dacpo_stats* st, const dacpo_search* search, dacpo
     /* Bridges change only the adjacency the later stages read (segmentation,
      * block graph, dipole weights); the k-NN lists and PCA normals are kept. */
     dacpo_adjacency bridged;
-    DACPO_TRY(dacpo_bridge_components(&s->cloud, &s->adj, s->component, s->num_components,
-                                      2, &bridged, &st->bridges_added, &st->longest_bridge,
+    DACPO_TRY(dacpo_bridge_components(&s->cloud,
+                                      &s->adj,
+                                      s->component,
+                                      s->num_components,
+                                      2,
+                                      &bridged,
+                                      &st->bridges_added,
+                                      &st->longest_bridge,
                                       err));
     dacpo_adjacency_free(&s->adj);
     s->adj = bridged;
@@ -166,8 +189,8 @@ estimate_normals(run_state* s, dacpo_err* err)
   s->curvature = dacpo_malloc_array(n, sizeof(float));
   if (!s->curvature)
     return DACPO_OOM(err);
-  return dacpo_normals_pca(&s->cloud, &s->knn, nk, s->p.num_threads, s->cloud.nrm, s->curvature,
-                           err);
+  return dacpo_normals_pca(
+      &s->cloud, &s->knn, nk, s->p.num_threads, s->cloud.nrm, s->curvature, err);
 }
 
 /* ---- stages 2-3: one block at a time ----------------------------------- */
@@ -222,8 +245,8 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     dacpo_ipsr_params ip;
     dacpo_ipsr_params_default(&ip);
     ip.max_iterations = s->p.ipsr_enabled ? s->p.ipsr_max_iterations : 0;
-    st = dacpo_ipsr_block(xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b],
-                          err);
+    st = dacpo_ipsr_block(
+        xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b], err);
     s->block_seconds[2 * b + 1] = dacpo_now() - t1;
     if (st != DACPO_OK)
       goto done;
@@ -233,8 +256,9 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     memcpy(s->oriented + 3 * q, nrm + 3 * i, 3 * sizeof(double));
     /* nrm started as sign * axis: a negative dot means stage 3 turned it over */
     const double* a = s->cloud.nrm + 3 * q;
-    const double d = (a[0] * nrm[3 * i] + a[1] * nrm[3 * i + 1] + a[2] * nrm[3 * i + 2]) *
-                     (double)sign[i];
+    const double d =
+        (a[0] * nrm[3 * i] + a[1] * nrm[3 * i + 1] + a[2] * nrm[3 * i + 2]) *
+        (double)sign[i];
     s->point_conf[q] = d >= 0.0 ? conf[i] : 0.5f * conf[i];
   }
   if (s->ring_oriented)
@@ -262,8 +286,12 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
   vp.perspective = s->p.vcr_perspective != 0;
   vp.boundary_factor = s->p.vcr_boundary_factor != 0;
   (void)thread_id;
-  return dacpo_vcr_edge(&s->meshes[edge->a], &s->meshes[edge->b], &vp, &edge->alpha,
-                        &edge->alpha_bar, err);
+  return dacpo_vcr_edge(&s->meshes[edge->a],
+                        &s->meshes[edge->b],
+                        &vp,
+                        &edge->alpha,
+                        &edge->alpha_bar,
+                        err);
 }
 
 /* ---- stage 5 ----------------------------------------------------------- */
@@ -317,13 +345,19 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
     const dacpo_block_edge* be = &s->bgraph.edges[e];
     ie[e].a = be->a;
     ie[e].b = be->b;
-    dacpo_edge_omega(be->alpha, be->alpha_bar, s->evidence_scale, &ie[e].w_same,
-                     &ie[e].w_diff);
+    dacpo_edge_omega(
+        be->alpha, be->alpha_bar, s->evidence_scale, &ie[e].w_same, &ie[e].w_diff);
     if (be->alpha == 0.0 && be->alpha_bar == 0.0)
       st->zero_weight_edges++;
   }
-  dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks, ne, ie, s->p.solver_time_limit,
-                                   s->progress, s->flips, &s->ilp, err);
+  dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks,
+                                   ne,
+                                   ie,
+                                   s->p.solver_time_limit,
+                                   s->progress,
+                                   s->flips,
+                                   &s->ilp,
+                                   err);
   if (r == DACPO_OK)
     r = block_confidence(s, ie, ne, err);
   free(ie);
@@ -360,21 +394,13 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
     const dacpo_block_edge* be = &s->bgraph.edges[e];
     if (!(be->alpha + be->alpha_bar >= weak * s->evidence_scale))
       continue;
-    int32_t a = be->a, b = be->b;
-    while (root[a] != a)
-      a = root[a] = root[root[a]];
-    while (root[b] != b)
-      b = root[b] = root[root[b]];
-    if (a != b)
-      root[a] = b;
+    dacpo_uf_union(root, be->a, be->b);
   }
   size_t m = 0;
   for (size_t b = 0; b < nb; ++b)
     id[b] = -1;
   for (size_t b = 0; b < nb; ++b) {
-    int32_t r = (int32_t)b;
-    while (root[r] != r)
-      r = root[r];
+    const int32_t r = dacpo_uf_find(root, (int32_t)b);
     if (id[r] < 0)
       id[r] = (int32_t)m++;
     id[b] = id[r];
@@ -468,8 +494,15 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
     free(final);
     return DACPO_OOM(err);
   }
-  dacpo_status r = dacpo_part_signs(s->cloud.xyz, final, n, s->part, np, s->part_sign,
-                                    s->part_conf, &st->view_score, err);
+  dacpo_status r = dacpo_part_signs(s->cloud.xyz,
+                                    final,
+                                    n,
+                                    s->part,
+                                    np,
+                                    s->part_sign,
+                                    s->part_conf,
+                                    &st->view_score,
+                                    err);
   free(final);
   if (r == DACPO_OK && np > s->num_components)
     r = keep_weak_evidence(s, np, err);
@@ -494,9 +527,14 @@ choose_global_sign(run_state* s, dacpo_stats* st, dacpo_err* err)
     return DACPO_OOM(err);
   dacpo_global_sign_result g;
   const dacpo_status r = dacpo_global_sign(
-      s->cloud.xyz, now, s->cloud.n,
-      s->p.sign_policy == DACPO_SIGN_VIEWPOINT ? s->p.viewpoint : NULL, s->knn.sqd, s->knn.k,
-      &g, err);
+      s->cloud.xyz,
+      now,
+      s->cloud.n,
+      s->p.sign_policy == DACPO_SIGN_VIEWPOINT ? s->p.viewpoint : NULL,
+      s->knn.sqd,
+      s->knn.k,
+      &g,
+      err);
   free(now);
   if (r != DACPO_OK)
     return r;
@@ -520,8 +558,11 @@ publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
     nv += s->meshes[b].num_vertices;
     nt += s->meshes[b].num_triangles;
   }
-  DACPO_CHECK(err, nv < (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "scene mesh has %zu vertices, more than int32 indices hold", nv);
+  DACPO_CHECK(err,
+              nv < (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "scene mesh has %zu vertices, more than int32 indices hold",
+              nv);
   ctx->mesh_vertices = dacpo_malloc_array(3 * nv, sizeof(float));
   ctx->mesh_triangles = dacpo_malloc_array(3 * nt, sizeof(int32_t));
   if (!ctx->mesh_vertices || !ctx->mesh_triangles)
@@ -574,8 +615,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
   if (s->curvature)
     ctx->point_curvature = dacpo_malloc_array(count, sizeof(float));
   if (!ctx->point_component || !ctx->point_block || !ctx->point_confidence ||
-      !ctx->block_flips || !ctx->edges ||
-      (s->curvature && !ctx->point_curvature))
+      !ctx->block_flips || !ctx->edges || (s->curvature && !ctx->point_curvature))
     return DACPO_OOM(err);
 
   memcpy(ctx->block_flips, s->flips, s->blocks.num_blocks);
@@ -588,7 +628,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     info->block_b = be->b;
     info->alpha = be->alpha;
     info->alpha_bar = be->alpha_bar;
-    info->confidence = fabs(be->alpha - be->alpha_bar) / (be->alpha + be->alpha_bar + 1e-12);
+    info->confidence =
+        fabs(be->alpha - be->alpha_bar) / (be->alpha + be->alpha_bar + 1e-12);
   }
 
   /* Everything that can fail comes before the caller's normals are written:
@@ -656,17 +697,19 @@ run(dacpo_ctx* ctx,
 {
   dacpo_stats* st = &ctx->stats;
   double t = dacpo_now();
-#define STAGE_DONE(stage)                                                      \
-  do {                                                                         \
-    double now_ = dacpo_now();                                                 \
-    st->stage_seconds[stage] = now_ - t;                                       \
-    t = now_;                                                                  \
-    DACPO_TRY(report(s, (stage), 1.0, err));                                   \
+#define STAGE_DONE(stage)                                                              \
+  do {                                                                                 \
+    double now_ = dacpo_now();                                                         \
+    st->stage_seconds[stage] = now_ - t;                                               \
+    t = now_;                                                                          \
+    DACPO_TRY(report(s, (stage), 1.0, err));                                           \
   } while (0)
 
   DACPO_TRY(report(s, DACPO_STAGE_INPUT, 0.0, err));
   /* count == 0 first: empty std::vectors hand over NULL pointers */
-  DACPO_CHECK(err, count == 0 || normals != NULL, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              count == 0 || normals != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
               "normals is NULL: it is the buffer that receives the oriented normals");
   const float* given = s->p.estimate_normals ? NULL : normals;
   DACPO_TRY(dacpo_input_check(xyz, given, count, err));
@@ -684,14 +727,20 @@ run(dacpo_ctx* ctx,
   STAGE_DONE(DACPO_STAGE_NORMALS);
 
   size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
-  DACPO_TRY(dacpo_segment(&s->cloud, &s->adj, s->component, s->num_components, target,
-                          s->p.ring_hops, &s->blocks, err));
+  DACPO_TRY(dacpo_segment(&s->cloud,
+                          &s->adj,
+                          s->component,
+                          s->num_components,
+                          target,
+                          s->p.ring_hops,
+                          &s->blocks,
+                          err));
   DACPO_TRY(dacpo_block_graph_build(&s->blocks, &s->adj, &s->bgraph, err));
   st->num_blocks = s->blocks.num_blocks;
   st->num_block_edges = s->bgraph.num_edges;
   for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
-    size_t nb = s->blocks.own_start[b + 1] - s->blocks.own_start[b] + s->blocks.ring_start[b + 1] -
-                s->blocks.ring_start[b];
+    size_t nb = s->blocks.own_start[b + 1] - s->blocks.own_start[b] +
+                s->blocks.ring_start[b + 1] - s->blocks.ring_start[b];
     if (nb > st->peak_block_points)
       st->peak_block_points = nb;
   }
@@ -709,12 +758,17 @@ run(dacpo_ctx* ctx,
   const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
   if (want_ring)
     s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
-  if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds || (want_meshes && !s->meshes) ||
-      (want_ring && !s->ring_oriented))
+  if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
+      (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
     return DACPO_OOM(err);
-  DACPO_TRY(dacpo_parallel_for(nb, s->p.num_threads, orient_block, s,
-                               s->progress, s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
-                               err));
+  DACPO_TRY(
+      dacpo_parallel_for(nb,
+                         s->p.num_threads,
+                         orient_block,
+                         s,
+                         s->progress,
+                         s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
+                         err));
   for (size_t b = 0; b < nb; ++b) {
     st->ipsr_iterations_total += s->ipsr[b].iterations;
     if (s->ipsr[b].iterations > st->ipsr_iterations_max)
@@ -735,14 +789,19 @@ run(dacpo_ctx* ctx,
   }
 
   if (want_meshes)
-    DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges, s->p.num_threads, weigh_edge_vcr, s,
-                                 s->progress, DACPO_STAGE_EDGE_WEIGHTS, err));
+    DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges,
+                                 s->p.num_threads,
+                                 weigh_edge_vcr,
+                                 s,
+                                 s->progress,
+                                 DACPO_STAGE_EDGE_WEIGHTS,
+                                 err));
   else if (want_ring)
-    DACPO_TRY(dacpo_block_graph_overlap_weights(&s->bgraph, &s->blocks, s->oriented,
-                                                s->ring_oriented, err));
+    DACPO_TRY(dacpo_block_graph_overlap_weights(
+        &s->bgraph, &s->blocks, s->oriented, s->ring_oriented, err));
   else
-    DACPO_TRY(dacpo_block_graph_dipole_weights(&s->bgraph, &s->cloud, &s->adj, &s->blocks,
-                                               s->oriented, s->p.dipole_c, err));
+    DACPO_TRY(dacpo_block_graph_dipole_weights(
+        &s->bgraph, &s->cloud, &s->adj, &s->blocks, s->oriented, s->p.dipole_c, err));
   STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
 
   DACPO_TRY(solve_flips(s, st, err));

@@ -232,29 +232,6 @@ check_mesh(const dacpo_mesh* m, const char* name, dacpo_err* err)
   return DACPO_OK;
 }
 
-static int32_t
-uf_find(int32_t* parent, int32_t x)
-{
-  while (parent[x] != x) {
-    parent[x] = parent[parent[x]]; /* path halving */
-    x = parent[x];
-  }
-  return x;
-}
-
-/* The smaller index becomes the root: a root then precedes every member in scan
- * order, which lets one scan hand out compact ids. */
-static void
-uf_union(int32_t* parent, int32_t x, int32_t y)
-{
-  x = uf_find(parent, x);
-  y = uf_find(parent, y);
-  if (x < y)
-    parent[y] = x;
-  else if (y < x)
-    parent[x] = y;
-}
-
 static dacpo_status
 work_alloc(vcr_work* w, dacpo_err* err)
 {
@@ -605,7 +582,7 @@ run_view(vcr_work* w,
         uint8_t cq = cls[p - N];
         if (cq == cp) {
           if (parent[p] != parent[p - N]) /* cheap test first: usually one root */
-            uf_union(parent, (int32_t)p, (int32_t)(p - N));
+            dacpo_uf_union(parent, (int32_t)p, (int32_t)(p - N));
         }
         else if (((cq - 1) >> 1) != ((cp - 1) >> 1)) {
           int same_face = ((cq - 1) & 1) == ((cp - 1) & 1);
@@ -627,7 +604,7 @@ run_view(vcr_work* w,
       uint8_t cp = cls[p];
       if (cp == 0)
         continue;
-      int32_t root = uf_find(parent, (int32_t)p);
+      int32_t root = dacpo_uf_find(parent, (int32_t)p);
       int32_t id;
       if (root == (int32_t)p) {
         id = K++;
@@ -646,9 +623,9 @@ run_view(vcr_work* w,
       w->a_cbs[id] += (f & PF_SAME) ? 1 : 0;
       w->a_cbd[id] += (f & PF_DIFF) ? 1 : 0;
       if (f & PF_LEFT_X)
-        uf_union(w->a_par[(f & PF_LEFT_SAME) ? 0 : 1], id, w->atom[p - 1]);
+        dacpo_uf_union(w->a_par[(f & PF_LEFT_SAME) ? 0 : 1], id, w->atom[p - 1]);
       if (f & PF_UP_X)
-        uf_union(w->a_par[(f & PF_UP_SAME) ? 0 : 1], id, w->atom[p - N]);
+        dacpo_uf_union(w->a_par[(f & PF_UP_SAME) ? 0 : 1], id, w->atom[p - N]);
       if (image != NULL) {
         uint8_t code = cp;
         if (f & (PF_SAME | PF_DIFF))
@@ -666,7 +643,7 @@ run_view(vcr_work* w,
     memset(w->acc_c2, 0, (size_t)K * sizeof(int32_t));
     memset(w->acc_cb, 0, (size_t)K * sizeof(int32_t));
     for (int32_t k = 0; k < K; ++k) {
-      int32_t r = uf_find(par, k);
+      int32_t r = dacpo_uf_find(par, k);
       if (w->a_blk[k])
         w->acc_c2[r] += w->a_cnt[k];
       else
