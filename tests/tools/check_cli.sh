@@ -228,6 +228,9 @@ bad_files)
   cp "$d/renamed_ply.pcd" "$d/renamed_ply.ply"
   printf "${ply_header}0 0 0 0 0 1\n1 five 0 0 0 1\n0 1 0 0 0 1\n" >"$d/word.ply"
   printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n0 0 0\n1 five 0\n0 1 0\n' >"$d/word.pcd"
+  # binary data whose first bytes spell COLUMNS: PCL 1.13 aborts (found by fuzzing)
+  { printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA binary\nCOLUMNS'
+    head -c 29 /dev/zero; } >"$d/columns.pcd"
   ;;
 full_disk)
   [ $# -eq 5 ] || fail "full_disk needs ORIENT EVAL box.ply DIR"

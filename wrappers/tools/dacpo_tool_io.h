@@ -278,6 +278,18 @@ checkPcd(std::FILE* f, long long file_size, const std::string& path, std::string
   if (width > (1ull << 40) || height > (1ull << 40) || width * height != points)
     return bad("WIDTH x HEIGHT differs from POINTS");
   const long long header_end = std::ftell(f);
+  if (data != "ascii") {
+    /* PCL 1.13 throws an uncaught std::length_error (abort) when binary data
+     * starts with the bytes of the old header keyword COLUMNS (found by
+     * fuzzing) */
+    char head[7] = {0};
+    const std::size_t got = std::fread(head, 1, sizeof(head), f);
+    if (got == sizeof(head) && std::memcmp(head, "COLUMNS", sizeof(head)) == 0)
+      return bad(
+          "the binary data starts with 'COLUMNS', which PCL's reader takes for a "
+          "header line");
+    std::fseek(f, header_end, SEEK_SET);
+  }
   if (data == "binary") {
     if (points > 0 &&
         (unsigned long long)(file_size - header_end) < points * point_size)
