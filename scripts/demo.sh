@@ -12,9 +12,11 @@ tools="$build/wrappers"
 
 "$tools/dacpo_make_scene" "$out/room.ply" -scene room -n 100000 -seed 1
 echo "== orienting $out/room.ply (normals re-estimated by PCA, signs unknown)"
-"$tools/pcl_dacpo_orient" "$out/room.ply" "$out/room_oriented.pcd" -estimate
+"$tools/pcl_dacpo_orient" "$out/room.ply" "$out/room_oriented.pcd" -estimate \
+  -normals_colored "$out/room_signs.pcd"
 echo "== error against ground truth (paper metric: % of normals > 90 deg off)"
 "$tools/pcl_dacpo_eval" "$out/room.ply" "$out/room_oriented.pcd" -colored "$out/room_colored.pcd"
 echo
 echo "View:  pcl_viewer $out/room_oriented.pcd -normals 10 -normals_scale 0.05"
 echo "       pcl_viewer $out/room_colored.pcd      (blue = correct, red = wrong)"
+echo "       pcl_viewer $out/room_signs.pcd        (colour = normal direction: floor blue = facing up)"
