@@ -14,10 +14,12 @@
 
 #include <dacpo/dacpo.h>
 
+#include <pcl/conversions.h>
 #include <pcl/features/feature.h>
 #include <pcl/memory.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/PolygonMesh.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -594,6 +596,32 @@ public:
   getMeshTriangles() const
   {
     return mesh_triangles_;
+  }
+
+  /** \brief The scene mesh of the last compute() with setKeepMesh(true) as a
+   *  pcl::PolygonMesh (vertex cloud x y z, triangles wound like the output
+   *  normals), ready for pcl::io::savePLYFile or the PCL visualizer. The block
+   *  meshes are not stitched: thin cracks remain along block seams. Returns
+   *  false (and leaves \a mesh empty) when there is none. */
+  bool
+  getMesh(pcl::PolygonMesh& mesh) const
+  {
+    mesh = pcl::PolygonMesh();
+    if (mesh_triangles_.empty())
+      return false;
+    pcl::PointCloud<pcl::PointXYZ> vertices;
+    vertices.resize(mesh_vertices_.size() / 3);
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+      vertices[i].getVector3fMap() << mesh_vertices_[3 * i], mesh_vertices_[3 * i + 1],
+          mesh_vertices_[3 * i + 2];
+    pcl::toPCLPointCloud2(vertices, mesh.cloud);
+    mesh.polygons.resize(mesh_triangles_.size() / 3);
+    for (std::size_t t = 0; t < mesh.polygons.size(); ++t)
+      mesh.polygons[t].vertices = {
+          static_cast<pcl::index_t>(mesh_triangles_[3 * t]),
+          static_cast<pcl::index_t>(mesh_triangles_[3 * t + 1]),
+          static_cast<pcl::index_t>(mesh_triangles_[3 * t + 2])};
+    return true;
   }
 
 protected:
