@@ -51,26 +51,47 @@ cmp_u64(const void* x, const void* y)
 static dacpo_status
 check_inputs(const dacpo_blocks* blocks, const dacpo_adjacency* adj, dacpo_err* err)
 {
-  DACPO_CHECK(err, blocks && adj, DACPO_ERR_INVALID_ARGUMENT, "block graph: NULL blocks or adjacency");
-  DACPO_CHECK(err, blocks->num_blocks <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "block graph: %zu blocks exceed int32 ids", blocks->num_blocks);
+  DACPO_CHECK(err,
+              blocks && adj,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "block graph: NULL blocks or adjacency");
+  DACPO_CHECK(err,
+              blocks->num_blocks <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "block graph: %zu blocks exceed int32 ids",
+              blocks->num_blocks);
   if (adj->n == 0)
     return DACPO_OK;
-  DACPO_CHECK(err, adj->n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "block graph: %zu points exceed int32 indices", adj->n);
-  DACPO_CHECK(err, blocks->block_of && adj->start && (adj->nbr || adj->start[adj->n] == 0),
-              DACPO_ERR_INVALID_ARGUMENT, "block graph: NULL block_of or adjacency arrays");
+  DACPO_CHECK(err,
+              adj->n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "block graph: %zu points exceed int32 indices",
+              adj->n);
+  DACPO_CHECK(err,
+              blocks->block_of && adj->start && (adj->nbr || adj->start[adj->n] == 0),
+              DACPO_ERR_INVALID_ARGUMENT,
+              "block graph: NULL block_of or adjacency arrays");
   for (size_t i = 0; i < adj->n; ++i) {
     const int32_t b = blocks->block_of[i];
-    DACPO_CHECK(err, b >= 0 && (size_t)b < blocks->num_blocks, DACPO_ERR_INVALID_ARGUMENT,
-                "block graph: point %zu has block %d, outside [0, %zu)", i, (int)b,
+    DACPO_CHECK(err,
+                b >= 0 && (size_t)b < blocks->num_blocks,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "block graph: point %zu has block %d, outside [0, %zu)",
+                i,
+                (int)b,
                 blocks->num_blocks);
-    DACPO_CHECK(err, adj->start[i] <= adj->start[i + 1], DACPO_ERR_INVALID_ARGUMENT,
-                "block graph: adjacency row %zu has a negative length", i);
+    DACPO_CHECK(err,
+                adj->start[i] <= adj->start[i + 1],
+                DACPO_ERR_INVALID_ARGUMENT,
+                "block graph: adjacency row %zu has a negative length",
+                i);
     for (size_t e = adj->start[i]; e < adj->start[i + 1]; ++e)
-      DACPO_CHECK(err, adj->nbr[e] >= 0 && (size_t)adj->nbr[e] < adj->n,
-                  DACPO_ERR_INVALID_ARGUMENT, "block graph: neighbour %d of point %zu out of range",
-                  (int)adj->nbr[e], i);
+      DACPO_CHECK(err,
+                  adj->nbr[e] >= 0 && (size_t)adj->nbr[e] < adj->n,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "block graph: neighbour %d of point %zu out of range",
+                  (int)adj->nbr[e],
+                  i);
   }
   return DACPO_OK;
 }
@@ -178,13 +199,24 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
                                  double c,
                                  dacpo_err* err)
 {
-  DACPO_CHECK(err, g && cloud, DACPO_ERR_INVALID_ARGUMENT, "dipole weights: NULL graph or cloud");
+  DACPO_CHECK(err,
+              g && cloud,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole weights: NULL graph or cloud");
   DACPO_TRY(check_inputs(blocks, adj, err));
-  DACPO_CHECK(err, cloud->n == adj->n, DACPO_ERR_INVALID_ARGUMENT,
-              "dipole weights: cloud has %zu points, adjacency %zu", cloud->n, adj->n);
-  DACPO_CHECK(err, isfinite(c), DACPO_ERR_INVALID_ARGUMENT, "dipole weights: c is not finite");
-  DACPO_CHECK(err, g->num_edges == 0 || g->edges, DACPO_ERR_INVALID_ARGUMENT,
-              "dipole weights: graph has %zu edges but no array", g->num_edges);
+  DACPO_CHECK(err,
+              cloud->n == adj->n,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole weights: cloud has %zu points, adjacency %zu",
+              cloud->n,
+              adj->n);
+  DACPO_CHECK(
+      err, isfinite(c), DACPO_ERR_INVALID_ARGUMENT, "dipole weights: c is not finite");
+  DACPO_CHECK(err,
+              g->num_edges == 0 || g->edges,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole weights: graph has %zu edges but no array",
+              g->num_edges);
   for (size_t e = 0; e < g->num_edges; ++e) {
     g->edges[e].alpha = 0.0;
     g->edges[e].alpha_bar = 0.0;
@@ -192,7 +224,9 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
   const size_t n = adj->n;
   if (n == 0)
     return DACPO_OK;
-  DACPO_CHECK(err, cloud->xyz && oriented_nrm, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              cloud->xyz && oriented_nrm,
+              DACPO_ERR_INVALID_ARGUMENT,
               "dipole weights: NULL points or normals");
   for (size_t i = 0; i < n; ++i)
     for (size_t k = adj->start[i]; k < adj->start[i + 1]; ++k) {
@@ -201,15 +235,23 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
       if (j <= i || a == b)
         continue;
       const ptrdiff_t e = dacpo_block_graph_find(g, a, b);
-      DACPO_CHECK(err, e >= 0, DACPO_ERR_INTERNAL,
-                  "dipole weights: points %zu and %zu join blocks %d and %d, which have no edge",
-                  i, j, (int)a, (int)b);
+      DACPO_CHECK(err,
+                  e >= 0,
+                  DACPO_ERR_INTERNAL,
+                  "dipole weights: points %zu and %zu join blocks %d and %d, which "
+                  "have no edge",
+                  i,
+                  j,
+                  (int)a,
+                  (int)b);
       /* Eq. 2 both ways; e is symmetric in its two arguments, so the sum is
        * twice one evaluation. Flipping one block negates s: its positive part is
        * evidence for "same", its negative part for "differ". */
-      const double s =
-          2.0 * dacpo_dipole_energy(cloud->xyz + 3 * i, oriented_nrm + 3 * i, cloud->xyz + 3 * j,
-                                    oriented_nrm + 3 * j, c);
+      const double s = 2.0 * dacpo_dipole_energy(cloud->xyz + 3 * i,
+                                                 oriented_nrm + 3 * i,
+                                                 cloud->xyz + 3 * j,
+                                                 oriented_nrm + 3 * j,
+                                                 c);
       if (s > 0.0)
         g->edges[e].alpha += s;
       else
@@ -219,7 +261,8 @@ dacpo_block_graph_dipole_weights(dacpo_block_graph* g,
 }
 
 void
-dacpo_edge_omega(double alpha, double alpha_bar, double scale, double* w_same, double* w_diff)
+dacpo_edge_omega(
+    double alpha, double alpha_bar, double scale, double* w_same, double* w_diff)
 {
   /* Eq. 7 gives every edge the same total weight, so a contact of a few pixels
    * or pairs outvotes a long shared wall around a cycle. The ratio is kept as
@@ -246,7 +289,8 @@ dacpo_edge_evidence_scale(const dacpo_block_graph* g)
 {
   /* median of alpha + alpha_bar over the edges that carry evidence */
   size_t m = 0;
-  double* v = g && g->num_edges ? dacpo_malloc_array(g->num_edges, sizeof(double)) : NULL;
+  double* v =
+      g && g->num_edges ? dacpo_malloc_array(g->num_edges, sizeof(double)) : NULL;
   if (!v)
     return 0.0;
   for (size_t e = 0; e < g->num_edges; ++e) {
@@ -269,7 +313,9 @@ dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
                                   const double* ring_nrm,
                                   dacpo_err* err)
 {
-  DACPO_CHECK(err, g && blocks && own_nrm, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              g && blocks && own_nrm,
+              DACPO_ERR_INVALID_ARGUMENT,
               "overlap weights: NULL graph, blocks or normals");
   for (size_t e = 0; e < g->num_edges; ++e) {
     g->edges[e].alpha = 0.0;
@@ -278,7 +324,10 @@ dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
   const size_t nb = blocks->num_blocks;
   if (nb == 0 || blocks->ring_start[nb] == 0)
     return DACPO_OK;
-  DACPO_CHECK(err, ring_nrm != NULL, DACPO_ERR_INVALID_ARGUMENT, "overlap weights: NULL ring normals");
+  DACPO_CHECK(err,
+              ring_nrm != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "overlap weights: NULL ring normals");
   for (size_t a = 0; a < nb; ++a)
     for (size_t r = blocks->ring_start[a]; r < blocks->ring_start[a + 1]; ++r) {
       const int32_t q = blocks->ring[r];

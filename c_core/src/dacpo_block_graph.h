@@ -64,7 +64,8 @@ dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
  * a = (alpha + alpha_bar)/scale; scale <= 0 gives g = 1 (Eq. 7 as printed).
  * (0, 0) without evidence. NULL outputs are skipped. */
 void
-dacpo_edge_omega(double alpha, double alpha_bar, double scale, double* w_same, double* w_diff);
+dacpo_edge_omega(
+    double alpha, double alpha_bar, double scale, double* w_same, double* w_diff);
 
 /* The typical evidence of an edge: the median of alpha + alpha_bar over the
  * edges that have any (0 when none has, or on allocation failure). */

@@ -21,17 +21,28 @@ const char*
 dacpo_status_string(dacpo_status status)
 {
   switch (status) {
-  case DACPO_OK: return "ok";
-  case DACPO_ERR_INVALID_ARGUMENT: return "invalid argument";
-  case DACPO_ERR_EMPTY_INPUT: return "empty input";
-  case DACPO_ERR_NONFINITE_INPUT: return "non-finite or zero-length input value";
-  case DACPO_ERR_TOO_FEW_POINTS: return "too few distinct points";
-  case DACPO_ERR_DISCONNECTED: return "neighbour graph is disconnected";
-  case DACPO_ERR_NEIGHBOR_SEARCH: return "neighbour search failed";
-  case DACPO_ERR_SOLVER: return "0-1 program solver failed";
-  case DACPO_ERR_OUT_OF_MEMORY: return "out of memory";
-  case DACPO_ERR_CANCELLED: return "cancelled";
-  case DACPO_ERR_INTERNAL: return "internal error";
+  case DACPO_OK:
+    return "ok";
+  case DACPO_ERR_INVALID_ARGUMENT:
+    return "invalid argument";
+  case DACPO_ERR_EMPTY_INPUT:
+    return "empty input";
+  case DACPO_ERR_NONFINITE_INPUT:
+    return "non-finite or zero-length input value";
+  case DACPO_ERR_TOO_FEW_POINTS:
+    return "too few distinct points";
+  case DACPO_ERR_DISCONNECTED:
+    return "neighbour graph is disconnected";
+  case DACPO_ERR_NEIGHBOR_SEARCH:
+    return "neighbour search failed";
+  case DACPO_ERR_SOLVER:
+    return "0-1 program solver failed";
+  case DACPO_ERR_OUT_OF_MEMORY:
+    return "out of memory";
+  case DACPO_ERR_CANCELLED:
+    return "cancelled";
+  case DACPO_ERR_INTERNAL:
+    return "internal error";
   }
   return "unknown status";
 }
@@ -39,9 +50,14 @@ dacpo_status_string(dacpo_status status)
 const char*
 dacpo_stage_name(dacpo_stage stage)
 {
-  static const char* const names[DACPO_STAGE_COUNT] = {
-      "input", "neighbors", "normals", "segment",
-      "dipole", "ipsr", "edge_weights", "ilp"};
+  static const char* const names[DACPO_STAGE_COUNT] = {"input",
+                                                       "neighbors",
+                                                       "normals",
+                                                       "segment",
+                                                       "dipole",
+                                                       "ipsr",
+                                                       "edge_weights",
+                                                       "ilp"};
   if ((int)stage < 0 || stage >= DACPO_STAGE_COUNT)
     return "unknown";
   return names[stage];
@@ -100,66 +116,95 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
   if (!p)
     return bad_field(message, size, "params is NULL");
   if (p->k < 2)
-    return bad_field(message, size,
+    return bad_field(message,
+                     size,
                      "k must be >= 2 (got %zu): a 1-NN graph splits every surface into "
                      "pairs",
                      p->k);
   if (p->k > 1000)
     return bad_field(message, size, "k must be <= 1000 (got %zu)", p->k);
   if (p->estimate_normals && (p->normal_k < 3 || p->normal_k > 1000))
-    return bad_field(message, size, "normal_k must be in [3, 1000] (got %zu)", p->normal_k);
+    return bad_field(
+        message, size, "normal_k must be in [3, 1000] (got %zu)", p->normal_k);
   if (p->num_blocks > 100000)
-    return bad_field(message, size, "num_blocks must be <= 100000 (got %zu)", p->num_blocks);
+    return bad_field(
+        message, size, "num_blocks must be <= 100000 (got %zu)", p->num_blocks);
   if (p->ring_hops > 64)
     return bad_field(message, size, "ring_hops must be <= 64 (got %zu)", p->ring_hops);
   if (!(p->dipole_c > 1.0) || !isfinite(p->dipole_c))
-    return bad_field(message, size, "dipole_c must be finite and > 1 (paper Eq. 1), got %g",
+    return bad_field(message,
+                     size,
+                     "dipole_c must be finite and > 1 (paper Eq. 1), got %g",
                      p->dipole_c);
   if (p->dipole_orders < 1 || p->dipole_orders > 16)
-    return bad_field(message, size, "dipole_orders must be in [1, 16] (got %zu)",
-                     p->dipole_orders);
+    return bad_field(
+        message, size, "dipole_orders must be in [1, 16] (got %zu)", p->dipole_orders);
   if (p->dipole_neighbors < 1 || p->dipole_neighbors > 1024)
-    return bad_field(message, size, "dipole_neighbors must be in [1, 1024] (got %zu)",
+    return bad_field(message,
+                     size,
+                     "dipole_neighbors must be in [1, 1024] (got %zu)",
                      p->dipole_neighbors);
   if (p->dipole_restarts < 1 || p->dipole_restarts > 64)
-    return bad_field(message, size, "dipole_restarts must be in [1, 64] (got %zu)",
+    return bad_field(message,
+                     size,
+                     "dipole_restarts must be in [1, 64] (got %zu)",
                      p->dipole_restarts);
   if (!(p->weak_edge_fraction >= 0.0) || !(p->weak_edge_fraction <= 1.0))
-    return bad_field(message, size, "weak_edge_fraction must be in [0, 1] (got %g)",
+    return bad_field(message,
+                     size,
+                     "weak_edge_fraction must be in [0, 1] (got %g)",
                      p->weak_edge_fraction);
-  if (p->sign_policy != DACPO_SIGN_FREE_SPACE && p->sign_policy != DACPO_SIGN_VIEWPOINT &&
-      p->sign_policy != DACPO_SIGN_KEEP)
-    return bad_field(message, size, "sign_policy must be FREE_SPACE, VIEWPOINT or KEEP (got %d)",
+  if (p->sign_policy != DACPO_SIGN_FREE_SPACE &&
+      p->sign_policy != DACPO_SIGN_VIEWPOINT && p->sign_policy != DACPO_SIGN_KEEP)
+    return bad_field(message,
+                     size,
+                     "sign_policy must be FREE_SPACE, VIEWPOINT or KEEP (got %d)",
                      (int)p->sign_policy);
   if (p->sign_policy == DACPO_SIGN_VIEWPOINT &&
-      !(isfinite(p->viewpoint[0]) && isfinite(p->viewpoint[1]) && isfinite(p->viewpoint[2])))
+      !(isfinite(p->viewpoint[0]) && isfinite(p->viewpoint[1]) &&
+        isfinite(p->viewpoint[2])))
     return bad_field(message, size, "viewpoint must be finite");
   if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
-    return bad_field(message, size, "dipole_final_sweep must be in [0, 1000] (got %d)",
+    return bad_field(message,
+                     size,
+                     "dipole_final_sweep must be in [0, 1000] (got %d)",
                      p->dipole_final_sweep);
   if (p->ipsr_max_iterations > 1000)
-    return bad_field(message, size, "ipsr_max_iterations must be <= 1000 (got %zu)",
+    return bad_field(message,
+                     size,
+                     "ipsr_max_iterations must be <= 1000 (got %zu)",
                      p->ipsr_max_iterations);
-  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY && p->edge_weight != DACPO_WEIGHT_VCR &&
-      p->edge_weight != DACPO_WEIGHT_OVERLAP)
-    return bad_field(message, size, "edge_weight has an unknown value %d", (int)p->edge_weight);
+  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY &&
+      p->edge_weight != DACPO_WEIGHT_VCR && p->edge_weight != DACPO_WEIGHT_OVERLAP)
+    return bad_field(
+        message, size, "edge_weight has an unknown value %d", (int)p->edge_weight);
   if (!(p->solver_time_limit > 0.0) || !isfinite(p->solver_time_limit))
-    return bad_field(message, size, "solver_time_limit must be finite and > 0 (got %g)",
+    return bad_field(message,
+                     size,
+                     "solver_time_limit must be finite and > 0 (got %g)",
                      p->solver_time_limit);
   if (!(p->dipole_noise_band >= 0.0) || !isfinite(p->dipole_noise_band))
-    return bad_field(message, size, "dipole_noise_band must be finite and >= 0 (got %g)",
+    return bad_field(message,
+                     size,
+                     "dipole_noise_band must be finite and >= 0 (got %g)",
                      p->dipole_noise_band);
   if (p->vcr_image_size < 16 || p->vcr_image_size > 4096)
-    return bad_field(message, size, "vcr_image_size must be in [16, 4096] (got %zu)",
+    return bad_field(message,
+                     size,
+                     "vcr_image_size must be in [16, 4096] (got %zu)",
                      p->vcr_image_size);
   if (p->vcr_views < 1 || p->vcr_views > 256)
-    return bad_field(message, size, "vcr_views must be in [1, 256] (got %zu)", p->vcr_views);
+    return bad_field(
+        message, size, "vcr_views must be in [1, 256] (got %zu)", p->vcr_views);
   if (p->num_threads > 1024)
-    return bad_field(message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
+    return bad_field(
+        message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
   if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&
-      p->disconnected != DACPO_DISCONNECTED_ERROR && p->disconnected != DACPO_DISCONNECTED_BRIDGE &&
+      p->disconnected != DACPO_DISCONNECTED_ERROR &&
+      p->disconnected != DACPO_DISCONNECTED_BRIDGE &&
       p->disconnected != DACPO_DISCONNECTED_VIEWPOINT)
-    return bad_field(message, size, "disconnected has an unknown value %d", (int)p->disconnected);
+    return bad_field(
+        message, size, "disconnected has an unknown value %d", (int)p->disconnected);
   return DACPO_OK;
 }
 

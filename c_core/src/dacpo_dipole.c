@@ -50,8 +50,8 @@ dacpo_dipole_energy(const double p[3],
 {
   const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
   const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-  const double scale = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + q[0] * q[0] +
-                       q[1] * q[1] + q[2] * q[2];
+  const double scale =
+      p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
   /* |r| below 1e-12 of the coordinates' magnitude is a (near) duplicate whose
    * direction r^ is rounding noise; the absolute floor keeps 1/|r|^3 finite.
    * Written as !(a > b) so a NaN also gives 0. */
@@ -105,7 +105,11 @@ dipole_work_free(dipole_work* wk)
 /* Median over points of the RMS distance of a point's K neighbours from its
  * tangent plane: the block's scale of "flat within noise". */
 static double
-block_noise_scale(const double* xyz, const double* nrm, size_t n, size_t K, const int32_t* nb,
+block_noise_scale(const double* xyz,
+                  const double* nrm,
+                  size_t n,
+                  size_t K,
+                  const int32_t* nb,
                   double* tmp)
 {
   for (size_t i = 0; i < n; ++i) {
@@ -114,7 +118,8 @@ block_noise_scale(const double* xyz, const double* nrm, size_t n, size_t K, cons
     double s2 = 0.0;
     for (size_t t = 0; t < K; ++t) {
       const double* q = xyz + 3 * (size_t)nb[i * K + t];
-      const double d = (q[0] - p[0]) * m[0] + (q[1] - p[1]) * m[1] + (q[2] - p[2]) * m[2];
+      const double d =
+          (q[0] - p[0]) * m[0] + (q[1] - p[1]) * m[1] + (q[2] - p[2]) * m[2];
       s2 += d * d;
     }
     tmp[i] = sqrt(s2 / (double)K);
@@ -168,7 +173,8 @@ dipole_neighbors(const double* xyz,
   if (!wk->nb || !wk->w || !wk->kbuf || !wk->kd)
     return DACPO_OOM(err);
   for (size_t i = 0; i < n; ++i) {
-    const size_t found = dacpo_kdtree_knn(wk->tree, xyz + 3 * i, K + 1, wk->kbuf, wk->kd);
+    const size_t found =
+        dacpo_kdtree_knn(wk->tree, xyz + 3 * i, K + 1, wk->kbuf, wk->kd);
     int32_t* row = wk->nb + i * K;
     size_t t = 0;
     for (size_t f = 0; f < found && t < K; ++f) {
@@ -292,7 +298,8 @@ dipole_decide(const dipole_work* wk, size_t K, size_t i, const int8_t* s)
 
 /* One randomized BFS order; signs placed in s (length n, zeroed here). */
 static void
-dipole_one_order(dipole_work* wk, size_t n, size_t K, dacpo_rng* rng, int8_t* s, int32_t* order_out)
+dipole_one_order(
+    dipole_work* wk, size_t n, size_t K, dacpo_rng* rng, int8_t* s, int32_t* order_out)
 {
   memset(s, 0, n);
   memset(wk->visited, 0, n);
@@ -386,8 +393,8 @@ dacpo_dipole_orient(const double* xyz,
  * its final decision, |sum_t s_j e_ji| / sum_t |e_ji| (1: every neighbour says
  * the same, 0: a tie). */
 static void
-dipole_confidence(const dipole_work* wk, size_t n, size_t K, size_t R, size_t best,
-                  float* confidence)
+dipole_confidence(
+    const dipole_work* wk, size_t n, size_t K, size_t R, size_t best, float* confidence)
 {
   const int8_t* s = wk->cand + best * n;
   for (size_t i = 0; i < n; ++i)
@@ -423,20 +430,35 @@ dacpo_dipole_orient_confidence(const double* xyz,
                                float* confidence,
                                dacpo_err* err)
 {
-  DACPO_CHECK(err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
+  DACPO_CHECK(
+      err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
   if (n == 0)
     return DACPO_OK;
-  DACPO_CHECK(err, xyz && nrm && sign_out, DACPO_ERR_INVALID_ARGUMENT,
-              "dipole: NULL array for %zu points", n);
-  DACPO_CHECK(err, n <= (size_t)INT32_MAX, DACPO_ERR_INVALID_ARGUMENT,
-              "dipole: %zu points exceed int32 indices", n);
-  DACPO_CHECK(err, params->orders >= 1 && params->orders <= DACPO_DIPOLE_MAX_ORDERS,
-              DACPO_ERR_INVALID_ARGUMENT, "dipole: orders must be in [1, %d] (got %zu)",
-              DACPO_DIPOLE_MAX_ORDERS, params->orders);
-  DACPO_CHECK(err, params->neighbors >= 1, DACPO_ERR_INVALID_ARGUMENT,
+  DACPO_CHECK(err,
+              xyz && nrm && sign_out,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: NULL array for %zu points",
+              n);
+  DACPO_CHECK(err,
+              n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: %zu points exceed int32 indices",
+              n);
+  DACPO_CHECK(err,
+              params->orders >= 1 && params->orders <= DACPO_DIPOLE_MAX_ORDERS,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: orders must be in [1, %d] (got %zu)",
+              DACPO_DIPOLE_MAX_ORDERS,
+              params->orders);
+  DACPO_CHECK(err,
+              params->neighbors >= 1,
+              DACPO_ERR_INVALID_ARGUMENT,
               "dipole: neighbors must be >= 1");
-  DACPO_CHECK(err, params->restarts <= 64, DACPO_ERR_INVALID_ARGUMENT,
-              "dipole: restarts must be <= 64 (got %zu)", params->restarts);
+  DACPO_CHECK(err,
+              params->restarts <= 64,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: restarts must be <= 64 (got %zu)",
+              params->restarts);
   if (n == 1) {
     sign_out[0] = 1;
     if (confidence)
@@ -449,7 +471,8 @@ dacpo_dipole_orient_confidence(const double* xyz,
 
   dipole_work wk;
   memset(&wk, 0, sizeof(wk));
-  dacpo_status st = dipole_neighbors(xyz, nrm, n, K, params->c, params->noise_band, &wk, err);
+  dacpo_status st =
+      dipole_neighbors(xyz, nrm, n, K, params->c, params->noise_band, &wk, err);
   if (st == DACPO_OK)
     st = dipole_graph(n, K, gk, &wk, err);
   if (st == DACPO_OK) {
@@ -458,7 +481,8 @@ dacpo_dipole_orient_confidence(const double* xyz,
     wk.queue = dacpo_malloc_array(n, sizeof(int32_t));
     wk.order0 = dacpo_malloc_array(n, sizeof(int32_t));
     wk.perm = dacpo_malloc_array(n, sizeof(int32_t));
-    wk.cand = dacpo_malloc_array(n * (params->restarts ? params->restarts : 1), sizeof(int8_t));
+    wk.cand = dacpo_malloc_array(n * (params->restarts ? params->restarts : 1),
+                                 sizeof(int8_t));
     if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm || !wk.cand)
       st = DACPO_OOM(err);
   }
@@ -509,7 +533,8 @@ dacpo_dipole_orient_confidence(const double* xyz,
       break;
     double energy = 0.0;
     for (size_t i = 0; i < n; ++i)
-      energy += (double)cand[i] * dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
+      energy +=
+          (double)cand[i] * dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
     if (energy > best_energy) {
       best_energy = energy;
       best = r;

@@ -7,26 +7,30 @@
 #include "dacpo_internal.h"
 
 typedef struct dacpo_dipole_params {
-  double c;           /* Eq. 1 constant (4 clean, 2 noisy) */
-  size_t orders;      /* M randomized BFS orders */
-  size_t neighbors;   /* K nearest placed points summed per decision */
-  size_t graph_k;     /* k of the BFS graph */
-  int final_sweep;    /* re-decision sweeps with all neighbours placed (until
-                         none changes, at most this many; 0 = none) */
-  size_t restarts;    /* independent runs of the M orders; the one with the
-                         highest block energy is kept (0 or 1 = one run) */
+  double c;         /* Eq. 1 constant (4 clean, 2 noisy) */
+  size_t orders;    /* M randomized BFS orders */
+  size_t neighbors; /* K nearest placed points summed per decision */
+  size_t graph_k;   /* k of the BFS graph */
+  int final_sweep;  /* re-decision sweeps with all neighbours placed (until
+                       none changes, at most this many; 0 = none) */
+  size_t restarts;  /* independent runs of the M orders; the one with the
+                       highest block energy is kept (0 or 1 = one run) */
   uint64_t seed;
-  uint64_t stream;    /* e.g. the block id: independent of thread count */
-  double noise_band;  /* 0 = off; else pairs whose offsets along both normals are
-                         below noise_band * (the block's median RMS offset of
-                         neighbours from a point's tangent plane) count as
-                         coplanar: the c term of Eq. 1 is dropped for them */
+  uint64_t stream;   /* e.g. the block id: independent of thread count */
+  double noise_band; /* 0 = off; else pairs whose offsets along both normals are
+                        below noise_band * (the block's median RMS offset of
+                        neighbours from a point's tangent plane) count as
+                        coplanar: the c term of Eq. 1 is dropped for them */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for
  * the dipole-boundary edge weight. Returns 0 for |r| below 1e-12 relative. */
 double
-dacpo_dipole_energy(const double p[3], const double n[3], const double q[3], const double m[3], double c);
+dacpo_dipole_energy(const double p[3],
+                    const double n[3],
+                    const double q[3],
+                    const double m[3],
+                    double c);
 
 /* Orients n points (xyz, nrm: 3n, nrm unit axes) of one block: sign_out[i] is
  * +1 or -1, the block's normals being sign_out[i] * nrm[i]. The overall sign is

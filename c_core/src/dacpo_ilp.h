@@ -12,10 +12,10 @@ typedef struct dacpo_ilp_edge {
 } dacpo_ilp_edge;
 
 typedef struct dacpo_ilp_result {
-  int optimal;          /* 1 if every component was proven optimal */
-  double objective;     /* sum of omega at the returned flips */
-  size_t constraints;   /* rows given to lp_solve */
-  size_t cuts_added;    /* odd-cycle cuts added beyond the triangles */
+  int optimal;           /* 1 if every component was proven optimal */
+  double objective;      /* sum of omega at the returned flips */
+  size_t constraints;    /* rows given to lp_solve */
+  size_t cuts_added;     /* odd-cycle cuts added beyond the triangles */
   size_t heuristic_wins; /* components where the heuristic incumbent was kept */
   double seconds;
 } dacpo_ilp_result;

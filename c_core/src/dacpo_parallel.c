@@ -135,7 +135,9 @@ dacpo_parallel_for(size_t num_tasks,
     return p.first_err.code;
   }
   if (cancelled)
-    return dacpo_err_set(err, DACPO_ERR_CANCELLED, "cancelled by the progress callback during %s",
+    return dacpo_err_set(err,
+                         DACPO_ERR_CANCELLED,
+                         "cancelled by the progress callback during %s",
                          dacpo_stage_name(stage));
   return DACPO_OK;
 }

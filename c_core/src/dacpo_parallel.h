@@ -9,7 +9,10 @@
 #include "dacpo_internal.h"
 
 /* One task. thread_id in [0, num_threads) lets a task use per-thread scratch. */
-typedef dacpo_status (*dacpo_task_fn)(void* user, size_t task, unsigned thread_id, dacpo_err* err);
+typedef dacpo_status (*dacpo_task_fn)(void* user,
+                                      size_t task,
+                                      unsigned thread_id,
+                                      dacpo_err* err);
 
 /* Runs fn(user, t, ...) for t in [0, num_tasks). Stops handing out tasks after
  * the first failure or a cancel from progress; returns the first error (lowest

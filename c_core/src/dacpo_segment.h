@@ -10,9 +10,9 @@ typedef struct dacpo_blocks {
   int32_t* block_of;           /* n: block of each distinct point */
   int32_t* component_of_block; /* num_blocks */
   size_t* own_start;           /* num_blocks + 1 */
-  int32_t* own;                /* n: points of block b at own[own_start[b] ..], ascending */
-  size_t* ring_start;          /* num_blocks + 1 */
-  int32_t* ring;               /* ring points of block b (owned by other blocks), ascending */
+  int32_t* own;       /* n: points of block b at own[own_start[b] ..], ascending */
+  size_t* ring_start; /* num_blocks + 1 */
+  int32_t* ring;      /* ring points of block b (owned by other blocks), ascending */
 } dacpo_blocks;
 
 /* Splits each component kd-style (median split on the widest axis) into about

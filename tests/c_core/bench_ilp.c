@@ -106,10 +106,21 @@ bench_run(size_t n, double p_diag, double noise, double limit, uint64_t seed)
     size_t agree = 0;
     for (size_t i = 0; i < n; ++i)
       agree += (flips[i] ^ flips[0]) == (g.planted[i] ^ g.planted[0]);
-    printf("%5zu blocks %5zu edges diag %.1f: %8.4f s  optimal %d  rows %6zu  cuts %4zu  "
-           "heur_wins %zu  obj %.4f (planted %.4f)  agree %zu/%zu\n",
-           n, g.m, p_diag, r.seconds, r.optimal, r.constraints, r.cuts_added,
-           r.heuristic_wins, r.objective, bench_objective(&g, g.planted), agree, n);
+    printf(
+        "%5zu blocks %5zu edges diag %.1f: %8.4f s  optimal %d  rows %6zu  cuts %4zu  "
+        "heur_wins %zu  obj %.4f (planted %.4f)  agree %zu/%zu\n",
+        n,
+        g.m,
+        p_diag,
+        r.seconds,
+        r.optimal,
+        r.constraints,
+        r.cuts_added,
+        r.heuristic_wins,
+        r.objective,
+        bench_objective(&g, g.planted),
+        agree,
+        n);
   }
   free(flips);
   free(g.edges);

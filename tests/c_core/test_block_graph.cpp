@@ -29,7 +29,8 @@ struct GridScene {
   dacpo_adjacency adj{};
   dacpo_blocks blocks{};
 
-  GridScene(size_t s, bool diagonal, const int32_t block_id[4]) : side(s)
+  GridScene(size_t s, bool diagonal, const int32_t block_id[4])
+      : side(s)
   {
     const size_t n = side * side;
     for (size_t y = 0; y < side; ++y)
@@ -66,7 +67,8 @@ struct GridScene {
     blocks.num_blocks = 4;
     blocks.block_of = block_of.data();
   }
-  void flip_block(int32_t b)
+  void
+  flip_block(int32_t b)
   {
     for (size_t i = 0; i < cloud.n; ++i)
       if (block_of[i] == b)
@@ -118,8 +120,9 @@ TEST(DacpoBlockGraph, DiagonalAdjacencyAddsCornerEdges)
   for (size_t e = 0; e < g.num_edges; ++e) {
     EXPECT_LT(g.edges[e].a, g.edges[e].b);
     if (e > 0) {
-      EXPECT_TRUE(g.edges[e - 1].a < g.edges[e].a ||
-                  (g.edges[e - 1].a == g.edges[e].a && g.edges[e - 1].b < g.edges[e].b));
+      EXPECT_TRUE(
+          g.edges[e - 1].a < g.edges[e].a ||
+          (g.edges[e - 1].a == g.edges[e].a && g.edges[e - 1].b < g.edges[e].b));
     }
   }
   // Seams: 10 straight + 2 * 9 diagonal pairs; the two corner edges one each.
@@ -140,8 +143,8 @@ TEST(DacpoBlockGraph, DipoleWeightsFavourConsistentBlocks)
   dacpo_block_graph g{};
   dacpo_err err{};
   ASSERT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err), DACPO_OK);
-  ASSERT_EQ(dacpo_block_graph_dipole_weights(&g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0,
-                                             &err),
+  ASSERT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0, &err),
             DACPO_OK)
       << err.msg;
   for (size_t e = 0; e < g.num_edges; ++e) {
@@ -152,8 +155,8 @@ TEST(DacpoBlockGraph, DipoleWeightsFavourConsistentBlocks)
 
   // Flip block 3: its two edges now say "differ", the others are unchanged.
   s.flip_block(3);
-  ASSERT_EQ(dacpo_block_graph_dipole_weights(&g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0,
-                                             &err),
+  ASSERT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0, &err),
             DACPO_OK);
   for (size_t e = 0; e < g.num_edges; ++e) {
     const dacpo_block_edge& ed = g.edges[e];
@@ -226,13 +229,15 @@ TEST(DacpoBlockGraph, DipoleWeightsOnThinSheetWantOppositeNormals)
   ASSERT_EQ(dacpo_block_graph_build(&blocks, &adj, &g, &err), DACPO_OK);
   ASSERT_EQ(g.num_edges, 1u);
   EXPECT_EQ(g.edges[0].crossing, 100u);
-  ASSERT_EQ(dacpo_block_graph_dipole_weights(&g, &cloud, &adj, &blocks, nrm.data(), 4.0, &err),
+  ASSERT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &cloud, &adj, &blocks, nrm.data(), 4.0, &err),
             DACPO_OK);
   EXPECT_NEAR(g.edges[0].alpha, 100 * 2.0 * 3.0, 1e-9);
   EXPECT_EQ(g.edges[0].alpha_bar, 0.0);
   for (size_t i = side * side; i < n; ++i)
     nrm[3 * i + 2] = -nrm[3 * i + 2];
-  ASSERT_EQ(dacpo_block_graph_dipole_weights(&g, &cloud, &adj, &blocks, nrm.data(), 4.0, &err),
+  ASSERT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &cloud, &adj, &blocks, nrm.data(), 4.0, &err),
             DACPO_OK);
   EXPECT_EQ(g.edges[0].alpha, 0.0);
   EXPECT_NEAR(g.edges[0].alpha_bar, 600.0, 1e-9);
@@ -249,7 +254,8 @@ TEST(DacpoBlockGraph, OmegaOfEq7)
   dacpo_edge_omega(0.0, 0.0, 1.0, &ws, &wd); // no evidence: zero, not NaN
   EXPECT_EQ(ws, 0.0);
   EXPECT_EQ(wd, 0.0);
-  dacpo_edge_omega(1e-300, 0.0, 0.0, &ws, &wd); // tiny evidence keeps its ratio (no eps)
+  dacpo_edge_omega(
+      1e-300, 0.0, 0.0, &ws, &wd); // tiny evidence keeps its ratio (no eps)
   EXPECT_NEAR(ws, 1.0, 1e-12);
   dacpo_edge_omega(HUGE_VAL, 1.0, 1.0, &ws, &wd); // not finite: no evidence
   EXPECT_EQ(ws, 0.0);
@@ -275,7 +281,9 @@ TEST(DacpoBlockGraph, OmegaKeepsTheAmountOfEvidence)
 
 TEST(DacpoBlockGraph, EvidenceScaleIsTheMedianOfEdgesWithEvidence)
 {
-  dacpo_block_edge e[4] = {{0, 1, 1, 1.0, 0.0}, {0, 2, 1, 0.0, 0.0}, {1, 2, 1, 2.0, 1.0},
+  dacpo_block_edge e[4] = {{0, 1, 1, 1.0, 0.0},
+                           {0, 2, 1, 0.0, 0.0},
+                           {1, 2, 1, 2.0, 1.0},
                            {2, 3, 1, 5.0, 5.0}};
   dacpo_block_graph g = {4, e};
   EXPECT_DOUBLE_EQ(dacpo_edge_evidence_scale(&g), 3.0); // median of {1, 3, 10}
@@ -292,8 +300,8 @@ TEST(DacpoBlockGraph, SingleBlockAndEmptyInputHaveNoEdges)
   dacpo_err err{};
   ASSERT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err), DACPO_OK);
   EXPECT_EQ(g.num_edges, 0u);
-  EXPECT_EQ(dacpo_block_graph_dipole_weights(&g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0,
-                                             &err),
+  EXPECT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), 4.0, &err),
             DACPO_OK);
   dacpo_block_graph_free(&g);
 
@@ -311,32 +319,37 @@ TEST(DacpoBlockGraph, RejectsInconsistentInput)
   GridScene s(6, false, kIdentity);
   dacpo_block_graph g{};
   dacpo_err err{};
-  EXPECT_EQ(dacpo_block_graph_build(nullptr, &s.adj, &g, &err), DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, nullptr, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_build(nullptr, &s.adj, &g, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
 
   s.block_of[7] = 4; // outside [0, num_blocks)
-  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("point 7"), std::string::npos) << err.msg;
   EXPECT_EQ(g.num_edges, 0u);
   s.block_of[7] = 0;
 
   const int32_t saved = s.nbr[3];
   s.nbr[3] = 1000; // neighbour out of range
-  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   s.nbr[3] = saved;
 
   // A graph built for one labelling does not fit another.
   ASSERT_EQ(dacpo_block_graph_build(&s.blocks, &s.adj, &g, &err), DACPO_OK);
   const int32_t other[4] = {0, 3, 1, 2}; // seam lower-left|lower-right = (0, 3)
   GridScene t(6, false, other);
-  EXPECT_EQ(dacpo_block_graph_dipole_weights(&g, &t.cloud, &t.adj, &t.blocks, t.nrm.data(), 4.0,
-                                             &err),
+  EXPECT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &t.cloud, &t.adj, &t.blocks, t.nrm.data(), 4.0, &err),
             DACPO_ERR_INTERNAL)
       << err.msg;
-  EXPECT_EQ(dacpo_block_graph_dipole_weights(&g, &s.cloud, &s.adj, &s.blocks, nullptr, 4.0, &err),
+  EXPECT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &s.cloud, &s.adj, &s.blocks, nullptr, 4.0, &err),
             DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_block_graph_dipole_weights(&g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), NAN,
-                                             &err),
+  EXPECT_EQ(dacpo_block_graph_dipole_weights(
+                &g, &s.cloud, &s.adj, &s.blocks, s.nrm.data(), NAN, &err),
             DACPO_ERR_INVALID_ARGUMENT);
   dacpo_block_graph_free(&g);
 }
@@ -363,7 +376,8 @@ TEST(DacpoBlockGraph, TinyContactCannotOutvoteALongSharedBoundary)
   uint8_t flips[6];
   dacpo_ilp_result r;
   dacpo_err err = {DACPO_OK, {0}};
-  ASSERT_EQ(dacpo_ilp_solve(6, ie.size(), ie.data(), 5.0, nullptr, flips, &r, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_ilp_solve(6, ie.size(), ie.data(), 5.0, nullptr, flips, &r, &err),
+            DACPO_OK)
       << err.msg;
   for (int b = 1; b < 6; ++b)
     EXPECT_EQ(flips[b], flips[0]) << "block " << b;

@@ -22,14 +22,20 @@ const double kPi = 3.14159265358979323846;
 struct Shape {
   std::vector<double> xyz, truth, nrm;
   std::vector<int> flip;
-  size_t size() const { return xyz.size() / 3; }
-  void add(double x, double y, double z, double nx, double ny, double nz)
+  size_t
+  size() const
+  {
+    return xyz.size() / 3;
+  }
+  void
+  add(double x, double y, double z, double nx, double ny, double nz)
   {
     const double l = std::sqrt(nx * nx + ny * ny + nz * nz);
     xyz.insert(xyz.end(), {x, y, z});
     truth.insert(truth.end(), {nx / l, ny / l, nz / l});
   }
-  void scramble(uint64_t seed)
+  void
+  scramble(uint64_t seed)
   {
     dacpo_rng rng;
     dacpo_rng_seed(&rng, seed, 99);
@@ -81,8 +87,9 @@ orient_score(const Shape& s, const dacpo_dipole_params& p)
 {
   std::vector<int8_t> sign(s.size(), 0);
   dacpo_err err{};
-  EXPECT_EQ(dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, sign.data(), &err),
-            DACPO_OK)
+  EXPECT_EQ(
+      dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, sign.data(), &err),
+      DACPO_OK)
       << err.msg;
   for (int8_t v : sign)
     EXPECT_TRUE(v == 1 || v == -1);
@@ -97,8 +104,12 @@ plane_patch(size_t side, double h, uint64_t seed)
   dacpo_rng_seed(&rng, seed, 1);
   for (size_t i = 0; i < side; ++i)
     for (size_t j = 0; j < side; ++j)
-      s.add(i * h + jitter(&rng, 0.2 * h), j * h + jitter(&rng, 0.2 * h), jitter(&rng, 0.02 * h),
-            jitter(&rng, 0.02), jitter(&rng, 0.02), 1.0);
+      s.add(i * h + jitter(&rng, 0.2 * h),
+            j * h + jitter(&rng, 0.2 * h),
+            jitter(&rng, 0.02 * h),
+            jitter(&rng, 0.02),
+            jitter(&rng, 0.02),
+            1.0);
   s.scramble(seed);
   return s;
 }
@@ -134,8 +145,12 @@ thin_board(size_t side, double h, uint64_t seed)
     const double nz = sheet == 0 ? 1.0 : -1.0;
     for (size_t i = 0; i < side; ++i)
       for (size_t j = 0; j < side; ++j)
-        s.add(i * h + jitter(&rng, 0.1 * h), j * h + jitter(&rng, 0.1 * h),
-              nz * 0.5 * h + jitter(&rng, 0.02 * h), 0.0, 0.0, nz);
+        s.add(i * h + jitter(&rng, 0.1 * h),
+              j * h + jitter(&rng, 0.1 * h),
+              nz * 0.5 * h + jitter(&rng, 0.02 * h),
+              0.0,
+              0.0,
+              nz);
   }
   s.scramble(seed);
   return s;
@@ -152,7 +167,11 @@ half_cylinder(size_t around, size_t along, uint64_t seed)
   for (size_t a = 0; a < around; ++a)
     for (size_t l = 0; l < along; ++l) {
       const double t = (a + 0.5) * h + jitter(&rng, 0.1 * h);
-      s.add(std::cos(t), std::sin(t), l * h + jitter(&rng, 0.1 * h), std::cos(t), std::sin(t),
+      s.add(std::cos(t),
+            std::sin(t),
+            l * h + jitter(&rng, 0.1 * h),
+            std::cos(t),
+            std::sin(t),
             0.0);
     }
   s.scramble(seed);
@@ -309,10 +328,12 @@ TEST(DacpoDipole, DeterministicForSeedAndStream)
   p.final_sweep = 0;
   std::vector<int8_t> a(s.size()), b(s.size());
   dacpo_err err{};
-  ASSERT_EQ(dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, a.data(), &err),
-            DACPO_OK);
-  ASSERT_EQ(dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, b.data(), &err),
-            DACPO_OK);
+  ASSERT_EQ(
+      dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, a.data(), &err),
+      DACPO_OK);
+  ASSERT_EQ(
+      dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, b.data(), &err),
+      DACPO_OK);
   EXPECT_EQ(a, b);
 }
 
@@ -352,9 +373,12 @@ TEST(DacpoDipole, RejectsBadArguments)
   const double xyz[6] = {0, 0, 0, 1, 0, 0}, n[6] = {0, 0, 1, 0, 0, 1};
   int8_t s[2];
   dacpo_err err{};
-  EXPECT_EQ(dacpo_dipole_orient(xyz, n, 2, nullptr, s, &err), DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_dipole_orient(nullptr, n, 2, &p, s, &err), DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_dipole_orient(xyz, n, 2, &p, nullptr, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_dipole_orient(xyz, n, 2, nullptr, s, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_dipole_orient(nullptr, n, 2, &p, s, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_dipole_orient(xyz, n, 2, &p, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   p.orders = 0;
   EXPECT_EQ(dacpo_dipole_orient(xyz, n, 2, &p, s, &err), DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("orders"), std::string::npos) << err.msg;
@@ -374,7 +398,8 @@ TEST(DacpoDipole, TimingReport)
     dacpo_dipole_params p = default_params();
     dacpo_err err{};
     const double t0 = dacpo_now();
-    ASSERT_EQ(dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, sign.data(), &err),
+    ASSERT_EQ(dacpo_dipole_orient(
+                  s.xyz.data(), s.nrm.data(), s.size(), &p, sign.data(), &err),
               DACPO_OK);
     const double t = dacpo_now() - t0;
     std::printf("[ timing   ] dipole n=%zu K=32 M=5: %.2f ms\n", s.size(), 1e3 * t);

@@ -86,14 +86,23 @@ struct Solved {
 };
 
 Solved
-Solve(size_t n, const Edges& edges, double time_limit = 30.0, const dacpo_progress* progress = nullptr)
+Solve(size_t n,
+      const Edges& edges,
+      double time_limit = 30.0,
+      const dacpo_progress* progress = nullptr)
 {
   Solved s;
   s.flips.assign(n, 7); // sentinel: must be overwritten with 0/1
   std::memset(&s.result, 0, sizeof(s.result));
   std::memset(&s.err, 0, sizeof(s.err));
-  s.status = dacpo_ilp_solve(n, edges.size(), edges.empty() ? nullptr : edges.data(), time_limit,
-                             progress, n ? s.flips.data() : nullptr, &s.result, &s.err);
+  s.status = dacpo_ilp_solve(n,
+                             edges.size(),
+                             edges.empty() ? nullptr : edges.data(),
+                             time_limit,
+                             progress,
+                             n ? s.flips.data() : nullptr,
+                             &s.result,
+                             &s.err);
   return s;
 }
 
@@ -106,32 +115,50 @@ ExpectValidAnswer(size_t n, const Edges& edges, const Solved& s)
   for (size_t i = 0; i < n; ++i) {
     ASSERT_LE(s.flips[i], 1) << "node " << i;
     if (low[i] == (int32_t)i) {
-      EXPECT_EQ(s.flips[i], 0) << "lowest node " << i << " of its component must be fixed to 0";
+      EXPECT_EQ(s.flips[i], 0)
+          << "lowest node " << i << " of its component must be fixed to 0";
     }
   }
-  EXPECT_NEAR(s.result.objective, Objective(edges, s.flips), 1e-9 * (1.0 + edges.size()));
+  EXPECT_NEAR(
+      s.result.objective, Objective(edges, s.flips), 1e-9 * (1.0 + edges.size()));
 }
 
 // Small deterministic generator (splitmix64), independent of the library RNG.
 struct Rng {
   uint64_t s;
-  explicit Rng(uint64_t seed) : s(seed) {}
-  uint64_t Next()
+  explicit Rng(uint64_t seed)
+      : s(seed)
+  {}
+  uint64_t
+  Next()
   {
     uint64_t z = (s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
   }
-  double Uniform() { return (double)(Next() >> 11) * (1.0 / 9007199254740992.0); }
-  size_t Below(size_t n) { return (size_t)(Next() % n); }
+  double
+  Uniform()
+  {
+    return (double)(Next() >> 11) * (1.0 / 9007199254740992.0);
+  }
+  size_t
+  Below(size_t n)
+  {
+    return (size_t)(Next() % n);
+  }
 };
 
 // A W x H grid of blocks, a diagonal in a share of the cells (3-cycles, as in
 // a surface segmentation), planted flips, confidences in [0.55, 1], a share of
 // noisy edges whose preference is reversed.
 Edges
-PlantedGrid(size_t w, size_t h, double p_diag, double noise, uint64_t seed, std::vector<uint8_t>* planted)
+PlantedGrid(size_t w,
+            size_t h,
+            double p_diag,
+            double noise,
+            uint64_t seed,
+            std::vector<uint8_t>* planted)
 {
   Rng rng(seed);
   size_t n = w * h;
@@ -144,7 +171,8 @@ PlantedGrid(size_t w, size_t h, double p_diag, double noise, uint64_t seed, std:
     bool same = (*planted)[a] == (*planted)[b];
     if (rng.Uniform() < noise)
       same = !same;
-    edges.push_back(E((int32_t)a, (int32_t)b, same ? conf : 1.0 - conf, same ? 1.0 - conf : conf));
+    edges.push_back(
+        E((int32_t)a, (int32_t)b, same ? conf : 1.0 - conf, same ? 1.0 - conf : conf));
   };
   for (size_t y = 0; y < h; ++y)
     for (size_t x = 0; x < w; ++x) {
@@ -170,7 +198,8 @@ HardGraph(size_t n, size_t m, uint64_t seed)
   Rng rng(seed);
   Edges edges;
   for (size_t i = 0; i < m; ++i)
-    edges.push_back(E((int32_t)rng.Below(n), (int32_t)rng.Below(n), rng.Uniform(), rng.Uniform()));
+    edges.push_back(
+        E((int32_t)rng.Below(n), (int32_t)rng.Below(n), rng.Uniform(), rng.Uniform()));
   return edges;
 }
 
@@ -198,8 +227,11 @@ TEST(DacpoIlp, IsolatedNodesAreNotFlipped)
 TEST(DacpoIlp, ChainFollowsEveryPreference)
 {
   // 0 -same- 1 -diff- 2 -diff- 3 -same- 4 -diff- 5: a tree, satisfiable exactly.
-  Edges edges = {E(0, 1, 0.9, 0.1), E(1, 2, 0.2, 0.8), E(2, 3, 0.3, 0.7),
-                 E(3, 4, 0.6, 0.4), E(4, 5, 0.05, 0.95)};
+  Edges edges = {E(0, 1, 0.9, 0.1),
+                 E(1, 2, 0.2, 0.8),
+                 E(2, 3, 0.3, 0.7),
+                 E(3, 4, 0.6, 0.4),
+                 E(4, 5, 0.05, 0.95)};
   Solved s = Solve(6, edges);
   ExpectValidAnswer(6, edges, s);
   std::vector<uint8_t> expect = {0, 0, 1, 0, 0, 1};
@@ -289,7 +321,8 @@ TEST(DacpoIlp, RandomGraphsMatchBruteForce)
     Solved s = Solve(n, edges);
     ExpectValidAnswer(n, edges, s);
     double bf = BruteForce(n, edges);
-    EXPECT_NEAR(s.result.objective, bf, 1e-9 * (1.0 + std::fabs(bf))) << "seed " << seed;
+    EXPECT_NEAR(s.result.objective, bf, 1e-9 * (1.0 + std::fabs(bf)))
+        << "seed " << seed;
     EXPECT_EQ(s.result.optimal, 1) << "seed " << seed;
     used_lp += s.result.constraints > 0;
     cut_instances += s.result.cuts_added > 0;
@@ -321,7 +354,10 @@ TEST(DacpoIlp, DisconnectedComponentsAreSolvedSeparately)
 {
   // Component A = {1, 3, 5, 7, 9} (frustrated 5-cycle), component B =
   // {2, 4, 6, 8} (K4, all "different"), nodes 0 and 10 isolated.
-  Edges edges = {E(3, 1, 0.1, 0.9), E(3, 5, 0.2, 0.8), E(5, 7, 0.1, 0.9), E(7, 9, 0.3, 0.7),
+  Edges edges = {E(3, 1, 0.1, 0.9),
+                 E(3, 5, 0.2, 0.8),
+                 E(5, 7, 0.1, 0.9),
+                 E(7, 9, 0.3, 0.7),
                  E(9, 1, 0.05, 0.95)};
   for (int a : {2, 4, 6, 8})
     for (int b : {2, 4, 6, 8})
@@ -469,7 +505,8 @@ TEST(DacpoIlp, ParallelEdgesAndSelfLoopsCount)
 {
   // Two parallel edges 0-1 add up (same: 0.3 + 0.3 < diff: 0.1 + 0.6); the
   // self loop on 2 always contributes its w_same.
-  Edges edges = {E(0, 1, 0.3, 0.1), E(1, 0, 0.3, 0.6), E(2, 2, 0.4, 0.9), E(1, 2, 0.8, 0.1)};
+  Edges edges = {
+      E(0, 1, 0.3, 0.1), E(1, 0, 0.3, 0.6), E(2, 2, 0.4, 0.9), E(1, 2, 0.8, 0.1)};
   Solved s = Solve(3, edges);
   ExpectValidAnswer(3, edges, s);
   std::vector<uint8_t> expect = {0, 1, 1};

@@ -45,7 +45,9 @@ makeCtx()
 // are not).
 struct Rng {
   uint64_t s;
-  explicit Rng(uint64_t seed) : s(seed) {}
+  explicit Rng(uint64_t seed)
+      : s(seed)
+  {}
   uint64_t
   next()
   {
@@ -130,7 +132,8 @@ lastError(const dacpo_ctx* c)
 bool
 hasWord(const std::string& s, const std::string& w)
 {
-  return std::regex_search(s, std::regex("(^|[^0-9A-Za-z_])" + w + "($|[^0-9A-Za-z_])"));
+  return std::regex_search(s,
+                           std::regex("(^|[^0-9A-Za-z_])" + w + "($|[^0-9A-Za-z_])"));
 }
 
 // A good run on the same context succeeds and clears the error text.
@@ -139,8 +142,9 @@ expectUsable(dacpo_ctx* ctx)
 {
   Cloud c = plane(20, 20, 0.05, 0.0, 0.0, 99);
   dacpo_params p = fastParams();
-  ASSERT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
-            DACPO_OK)
+  ASSERT_EQ(
+      dacpo_orient(ctx, &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
+      DACPO_OK)
       << lastError(ctx);
   EXPECT_STREQ(dacpo_ctx_last_error(ctx), "");
   EXPECT_EQ(dacpo_ctx_stats(ctx)->input_points, c.size());
@@ -160,9 +164,10 @@ expectFailure(dacpo_ctx* ctx,
               size_t count,
               dacpo_status want)
 {
-  const std::vector<unsigned char> before = nrm ? bytesOf(*nrm) : std::vector<unsigned char>();
-  dacpo_status got = dacpo_orient(
-      ctx, p, search, progress, xyz, nrm ? nrm->data() : nullptr, count);
+  const std::vector<unsigned char> before =
+      nrm ? bytesOf(*nrm) : std::vector<unsigned char>();
+  dacpo_status got =
+      dacpo_orient(ctx, p, search, progress, xyz, nrm ? nrm->data() : nullptr, count);
   EXPECT_EQ(got, want) << dacpo_status_string(got) << ": " << dacpo_ctx_last_error(ctx);
   if (nrm) {
     EXPECT_TRUE(bytesOf(*nrm) == before) << "the normals buffer was written on error";
@@ -226,9 +231,10 @@ TEST(DacpoInputErrors, NullContextIsInvalidArgument)
 {
   Cloud c = plane(10, 10, 0.1, 0, 0, 1);
   const auto before = bytesOf(c.nrm);
-  EXPECT_EQ(dacpo_orient(nullptr, nullptr, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
-            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_orient(
+          nullptr, nullptr, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
+      DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_TRUE(bytesOf(c.nrm) == before);
   EXPECT_EQ(dacpo_ctx_create(nullptr), DACPO_ERR_INVALID_ARGUMENT);
   ASSERT_NE(dacpo_ctx_last_error(nullptr), nullptr);
@@ -244,8 +250,14 @@ TEST(DacpoInputErrors, NullXyzIsInvalidArgument)
 {
   auto ctx = makeCtx();
   Cloud c = plane(10, 10, 0.1, 0, 0, 1);
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, nullptr, &c.nrm,
-                                  c.size(), DACPO_ERR_INVALID_ARGUMENT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(msg.find("xyz"), std::string::npos) << msg;
   expectUsable(ctx.get());
 }
@@ -254,13 +266,25 @@ TEST(DacpoInputErrors, NullNormalsIsInvalidArgument)
 {
   auto ctx = makeCtx();
   Cloud c = plane(10, 10, 0.1, 0, 0, 1);
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  nullptr, c.size(), DACPO_ERR_INVALID_ARGUMENT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  nullptr,
+                                  c.size(),
+                                  DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(msg.find("normals"), std::string::npos) << msg;
   // Also when the normals would only be estimated: the buffer receives them.
   dacpo_params p = fastParams();
   p.estimate_normals = 1;
-  msg = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), nullptr, c.size(),
+  msg = expectFailure(ctx.get(),
+                      &p,
+                      nullptr,
+                      nullptr,
+                      c.xyz.data(),
+                      nullptr,
+                      c.size(),
                       DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(msg.find("normals"), std::string::npos) << msg;
   expectUsable(ctx.get());
@@ -272,8 +296,14 @@ TEST(DacpoInputErrors, TooManyPointsIsInvalidArgument)
   auto ctx = makeCtx();
   Cloud c = plane(4, 4, 0.1, 0, 0, 1);
   const size_t huge = static_cast<size_t>(INT32_MAX);
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  &c.nrm, huge, DACPO_ERR_INVALID_ARGUMENT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  huge,
+                                  DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(msg.find(std::to_string(huge)), std::string::npos) << msg;
   expectUsable(ctx.get());
 }
@@ -284,14 +314,26 @@ TEST(DacpoInputErrors, ZeroCountIsEmptyInput)
 {
   auto ctx = makeCtx();
   Cloud c = plane(4, 4, 0.1, 0, 0, 1);
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  &c.nrm, 0, DACPO_ERR_EMPTY_INPUT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  0,
+                                  DACPO_ERR_EMPTY_INPUT);
   EXPECT_NE(msg.find("no points"), std::string::npos) << msg;
   // An empty std::vector may hand over data() == NULL: still "empty", not "NULL".
-  expectFailure(ctx.get(), nullptr, nullptr, nullptr, nullptr, &c.nrm, 0,
-                DACPO_ERR_EMPTY_INPUT);
+  expectFailure(
+      ctx.get(), nullptr, nullptr, nullptr, nullptr, &c.nrm, 0, DACPO_ERR_EMPTY_INPUT);
   std::vector<float> empty;
-  expectFailure(ctx.get(), nullptr, nullptr, nullptr, empty.data(), &empty, 0,
+  expectFailure(ctx.get(),
+                nullptr,
+                nullptr,
+                nullptr,
+                empty.data(),
+                &empty,
+                0,
                 DACPO_ERR_EMPTY_INPUT);
   expectUsable(ctx.get());
 }
@@ -303,14 +345,20 @@ TEST(DacpoInputErrors, OnePointIsTooFewPoints)
   auto ctx = makeCtx();
   std::vector<float> xyz = {1.0f, 2.0f, 3.0f};
   std::vector<float> nrm = {0.0f, 0.0f, 1.0f};
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, xyz.data(), &nrm, 1,
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  xyz.data(),
+                                  &nrm,
+                                  1,
                                   DACPO_ERR_TOO_FEW_POINTS);
   EXPECT_TRUE(hasWord(msg, "1")) << msg;
   dacpo_params p = fastParams();
   p.estimate_normals = 1;
   std::vector<float> out = sentinel(1);
-  expectFailure(ctx.get(), &p, nullptr, nullptr, xyz.data(), &out, 1,
-                DACPO_ERR_TOO_FEW_POINTS);
+  expectFailure(
+      ctx.get(), &p, nullptr, nullptr, xyz.data(), &out, 1, DACPO_ERR_TOO_FEW_POINTS);
   expectUsable(ctx.get());
 }
 
@@ -323,7 +371,13 @@ TEST(DacpoInputErrors, IdenticalPointsAreTooFewPoints)
     xyz.insert(xyz.end(), {0.5f, -1.25f, 2.0f});
     nrm.insert(nrm.end(), {0.0f, 1.0f, 0.0f});
   }
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, xyz.data(), &nrm, n,
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  xyz.data(),
+                                  &nrm,
+                                  n,
                                   DACPO_ERR_TOO_FEW_POINTS);
   // "1 distinct point(s) among 1000 given"
   EXPECT_TRUE(hasWord(msg, "1000")) << msg;
@@ -339,15 +393,27 @@ TEST(DacpoInputErrors, NanCoordinateNamesIndex)
   auto ctx = makeCtx();
   Cloud c = plane(50, 40, 0.05, 0, 0, 2);
   c.xyz[3 * 1042 + 1] = kNaN;
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  &c.nrm, c.size(), DACPO_ERR_NONFINITE_INPUT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "1042")) << msg;
   EXPECT_NE(msg.find("nan"), std::string::npos) << msg;
   // With normals to estimate, the coordinate is still checked.
   dacpo_params p = fastParams();
   p.estimate_normals = 1;
   std::vector<float> out = sentinel(c.size());
-  msg = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), &out, c.size(),
+  msg = expectFailure(ctx.get(),
+                      &p,
+                      nullptr,
+                      nullptr,
+                      c.xyz.data(),
+                      &out,
+                      c.size(),
                       DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "1042")) << msg;
   expectUsable(ctx.get());
@@ -358,13 +424,25 @@ TEST(DacpoInputErrors, InfCoordinateNamesIndex)
   auto ctx = makeCtx();
   Cloud c = plane(50, 40, 0.05, 0, 0, 3);
   c.xyz[3 * 1999 + 2] = kInf; // the last point
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  &c.nrm, c.size(), DACPO_ERR_NONFINITE_INPUT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "1999")) << msg;
   EXPECT_NE(msg.find("inf"), std::string::npos) << msg;
   // The first bad point is named, -inf included.
   c.xyz[3 * 17] = -kInf;
-  msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(), &c.nrm, c.size(),
+  msg = expectFailure(ctx.get(),
+                      nullptr,
+                      nullptr,
+                      nullptr,
+                      c.xyz.data(),
+                      &c.nrm,
+                      c.size(),
                       DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "17")) << msg;
   EXPECT_NE(msg.find("-inf"), std::string::npos) << msg;
@@ -378,8 +456,14 @@ TEST(DacpoInputErrors, ZeroNormalNamesIndex)
   c.nrm[3 * 7] = c.nrm[3 * 7 + 1] = c.nrm[3 * 7 + 2] = 0.0f;
   dacpo_params p = fastParams();
   p.estimate_normals = 0;
-  std::string msg = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), &c.nrm,
-                                  c.size(), DACPO_ERR_NONFINITE_INPUT);
+  std::string msg = expectFailure(ctx.get(),
+                                  &p,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "7")) << msg;
   EXPECT_NE(msg.find("zero"), std::string::npos) << msg;
   expectUsable(ctx.get());
@@ -390,13 +474,25 @@ TEST(DacpoInputErrors, NanNormalNamesIndex)
   auto ctx = makeCtx();
   Cloud c = plane(50, 40, 0.05, 0, 0, 5);
   c.nrm[3 * 1500] = kNaN;
-  std::string msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(),
-                                  &c.nrm, c.size(), DACPO_ERR_NONFINITE_INPUT);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "1500")) << msg;
   EXPECT_NE(msg.find("nan"), std::string::npos) << msg;
   c.nrm[3 * 1500] = 0.0f;
   c.nrm[3 * 600 + 1] = kInf;
-  msg = expectFailure(ctx.get(), nullptr, nullptr, nullptr, c.xyz.data(), &c.nrm, c.size(),
+  msg = expectFailure(ctx.get(),
+                      nullptr,
+                      nullptr,
+                      nullptr,
+                      c.xyz.data(),
+                      &c.nrm,
+                      c.size(),
                       DACPO_ERR_NONFINITE_INPUT);
   EXPECT_TRUE(hasWord(msg, "600")) << msg;
   expectUsable(ctx.get());
@@ -410,8 +506,8 @@ TEST(DacpoInputErrors, ZeroNormalIsFineWhenEstimating)
   c.nrm[3 * 9] = kNaN; // whatever the buffer holds is ignored
   dacpo_params p = fastParams();
   p.estimate_normals = 1;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK)
       << lastError(ctx.get());
   for (size_t i = 0; i < c.size(); ++i) {
@@ -437,8 +533,14 @@ TEST(DacpoInputErrors, KZeroIsInvalidArgument)
 
   auto ctx = makeCtx();
   Cloud c = plane(20, 20, 0.05, 0, 0, 7);
-  std::string m = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), &c.nrm,
-                                c.size(), DACPO_ERR_INVALID_ARGUMENT);
+  std::string m = expectFailure(ctx.get(),
+                                &p,
+                                nullptr,
+                                nullptr,
+                                c.xyz.data(),
+                                &c.nrm,
+                                c.size(),
+                                DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_TRUE(hasWord(m, "k")) << m;
   expectUsable(ctx.get());
 }
@@ -452,16 +554,21 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
   const Case cases[] = {
       {"dipole_c", [](dacpo_params* p) { p->dipole_c = 1.0; }},
       {"dipole_c", [](dacpo_params* p) { p->dipole_c = std::nan(""); }},
-      {"solver_time_limit", [](dacpo_params* p) { p->solver_time_limit = std::nan(""); }},
+      {"solver_time_limit",
+       [](dacpo_params* p) { p->solver_time_limit = std::nan(""); }},
       {"solver_time_limit", [](dacpo_params* p) { p->solver_time_limit = 0.0; }},
-      {"edge_weight", [](dacpo_params* p) { p->edge_weight = static_cast<dacpo_edge_weight>(7); }},
+      {"edge_weight",
+       [](dacpo_params* p) { p->edge_weight = static_cast<dacpo_edge_weight>(7); }},
       {"disconnected",
-       [](dacpo_params* p) { p->disconnected = static_cast<dacpo_disconnected_policy>(9); }},
+       [](dacpo_params* p) {
+         p->disconnected = static_cast<dacpo_disconnected_policy>(9);
+       }},
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 0; }},
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 65; }},
       {"dipole_final_sweep", [](dacpo_params* p) { p->dipole_final_sweep = -1; }},
       {"weak_edge_fraction", [](dacpo_params* p) { p->weak_edge_fraction = -0.5; }},
-      {"weak_edge_fraction", [](dacpo_params* p) { p->weak_edge_fraction = std::nan(""); }},
+      {"weak_edge_fraction",
+       [](dacpo_params* p) { p->weak_edge_fraction = std::nan(""); }},
       {"normal_k",
        [](dacpo_params* p) {
          p->estimate_normals = 1;
@@ -475,7 +582,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
   auto ctx = makeCtx();
   Cloud c = plane(20, 20, 0.05, 0, 0, 8);
   char msg[256];
-  EXPECT_EQ(dacpo_params_validate(nullptr, msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_params_validate(nullptr, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(msg).find("NULL"), std::string::npos) << msg;
   for (const Case& cs : cases) {
     SCOPED_TRACE(cs.field);
@@ -484,8 +592,14 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
     cs.set(&p);
     EXPECT_EQ(dacpo_params_validate(&p, msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);
     EXPECT_TRUE(hasWord(msg, cs.field)) << msg;
-    std::string m = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), &c.nrm,
-                                  c.size(), DACPO_ERR_INVALID_ARGUMENT);
+    std::string m = expectFailure(ctx.get(),
+                                  &p,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_INVALID_ARGUMENT);
     EXPECT_TRUE(hasWord(m, cs.field)) << m;
   }
   // A message buffer that is too small is truncated, not overrun.
@@ -509,8 +623,8 @@ TEST(DacpoInputErrors, KAtLeastCountIsClamped)
   dacpo_params p;
   dacpo_params_init(&p); // iPSR and VCR on: tiny blocks must still work
   p.k = 50;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK)
       << lastError(ctx.get());
   const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
@@ -523,8 +637,8 @@ TEST(DacpoInputErrors, KAtLeastCountIsClamped)
 
   // k < n is not clamped.
   p.k = 7;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK);
   EXPECT_EQ(dacpo_ctx_stats(ctx.get())->k_clamped, 0);
   EXPECT_EQ(dacpo_ctx_stats(ctx.get())->k_used, 7u);
@@ -551,8 +665,8 @@ TEST(DacpoInputErrors, ExactDuplicatesGetTheirOriginalsNormal)
   }
   dacpo_params p;
   dacpo_params_init(&p);
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK)
       << lastError(ctx.get());
   const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
@@ -574,7 +688,8 @@ TEST(DacpoInputErrors, ExactDuplicatesGetTheirOriginalsNormal)
     EXPECT_EQ(c.nrm[3 * i + 2], c.nrm[2]) << "plane oriented inconsistently at " << i;
 }
 
-// ---- degenerate geometry ----------------------------------------------------------------
+// ---- degenerate geometry
+// ----------------------------------------------------------------
 
 TEST(DacpoInputErrors, CollinearPointsGiveFiniteUnitNormals)
 {
@@ -621,9 +736,9 @@ TEST(DacpoInputErrors, CoplanarEstimatedNormalsAreConsistent)
   dacpo_params p;
   dacpo_params_init(&p);
   p.estimate_normals = 1;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), nrm.data(),
-                         c.size()),
-            DACPO_OK)
+  ASSERT_EQ(
+      dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), nrm.data(), c.size()),
+      DACPO_OK)
       << lastError(ctx.get());
   const float sign = nrm[2] > 0 ? 1.0f : -1.0f;
   size_t wrong = 0;
@@ -639,7 +754,8 @@ TEST(DacpoInputErrors, CoplanarEstimatedNormalsAreConsistent)
     EXPECT_LT(curv[i], 1e-5f) << i;
 }
 
-// ---- disconnected k-NN graph ---------------------------------------------------------------
+// ---- disconnected k-NN graph
+// ---------------------------------------------------------------
 
 namespace {
 
@@ -670,8 +786,8 @@ TEST(DacpoInputErrors, DisconnectedComponentsAreOrientedSeparately)
   dacpo_params p;
   dacpo_params_init(&p);
   p.disconnected = DACPO_DISCONNECTED_SEPARATE;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK)
       << lastError(ctx.get());
   const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
@@ -712,7 +828,12 @@ TEST(DacpoInputErrors, DisconnectedPartsAreRelatedByDefault)
     ASSERT_EQ(p.disconnected, DACPO_DISCONNECTED_VIEWPOINT);
     p.seed = seed;
     Cloud out = c;
-    ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, out.xyz.data(), out.nrm.data(),
+    ASSERT_EQ(dacpo_orient(ctx.get(),
+                           &p,
+                           nullptr,
+                           nullptr,
+                           out.xyz.data(),
+                           out.nrm.data(),
                            out.size()),
               DACPO_OK)
         << lastError(ctx.get());
@@ -733,15 +854,21 @@ TEST(DacpoInputErrors, DisconnectedPolicyErrorFails)
   dacpo_params p;
   dacpo_params_init(&p);
   p.disconnected = DACPO_DISCONNECTED_ERROR;
-  std::string msg = expectFailure(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), &c.nrm,
-                                  c.size(), DACPO_ERR_DISCONNECTED);
+  std::string msg = expectFailure(ctx.get(),
+                                  &p,
+                                  nullptr,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_DISCONNECTED);
   EXPECT_NE(msg.find("2 connected components"), std::string::npos) << msg;
   // The stats of the stages that ran are kept.
   EXPECT_EQ(dacpo_ctx_stats(ctx.get())->num_components, 2u);
   // One plane alone passes the same policy.
   Cloud a = plane(30, 30, 0.05, 0.0, 0.0, 21);
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, a.xyz.data(), a.nrm.data(),
-                         a.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, a.xyz.data(), a.nrm.data(), a.size()),
             DACPO_OK)
       << lastError(ctx.get());
   EXPECT_EQ(dacpo_ctx_stats(ctx.get())->num_components, 1u);
@@ -755,8 +882,8 @@ TEST(DacpoInputErrors, DisconnectedPolicyBridgeJoins)
   dacpo_params p;
   dacpo_params_init(&p);
   p.disconnected = DACPO_DISCONNECTED_BRIDGE;
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(),
-                         c.size()),
+  ASSERT_EQ(dacpo_orient(
+                ctx.get(), &p, nullptr, nullptr, c.xyz.data(), c.nrm.data(), c.size()),
             DACPO_OK)
       << lastError(ctx.get());
   const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
@@ -774,28 +901,47 @@ TEST(DacpoInputErrors, DisconnectedPolicyBridgeJoins)
     EXPECT_EQ(c.nrm[3 * i + 2], c.nrm[2]) << i;
 }
 
-// ---- callbacks ----------------------------------------------------------------------------
+// ---- callbacks
+// ----------------------------------------------------------------------------
 
 TEST(DacpoInputErrors, FailingNeighborSearchIsReported)
 {
   auto ctx = makeCtx();
   Cloud c = plane(20, 20, 0.05, 0, 0, 12);
   dacpo_search search = {failingSearch, nullptr};
-  std::string msg = expectFailure(ctx.get(), nullptr, &search, nullptr, c.xyz.data(),
-                                  &c.nrm, c.size(), DACPO_ERR_NEIGHBOR_SEARCH);
+  std::string msg = expectFailure(ctx.get(),
+                                  nullptr,
+                                  &search,
+                                  nullptr,
+                                  c.xyz.data(),
+                                  &c.nrm,
+                                  c.size(),
+                                  DACPO_ERR_NEIGHBOR_SEARCH);
   EXPECT_TRUE(hasWord(msg, "3")) << "the callback's return value: " << msg;
 
   // A failure for one query names that point, also with several threads.
   dacpo_search at123 = {failAtSearch, &c};
   dacpo_params p = fastParams();
   p.num_threads = 2;
-  msg = expectFailure(ctx.get(), &p, &at123, nullptr, c.xyz.data(), &c.nrm, c.size(),
+  msg = expectFailure(ctx.get(),
+                      &p,
+                      &at123,
+                      nullptr,
+                      c.xyz.data(),
+                      &c.nrm,
+                      c.size(),
                       DACPO_ERR_NEIGHBOR_SEARCH);
   EXPECT_TRUE(hasWord(msg, "123")) << msg;
 
   // Indices outside the arrays are caught, not followed.
   dacpo_search bad = {outOfRangeSearch, nullptr};
-  msg = expectFailure(ctx.get(), &p, &bad, nullptr, c.xyz.data(), &c.nrm, c.size(),
+  msg = expectFailure(ctx.get(),
+                      &p,
+                      &bad,
+                      nullptr,
+                      c.xyz.data(),
+                      &c.nrm,
+                      c.size(),
                       DACPO_ERR_NEIGHBOR_SEARCH);
   EXPECT_TRUE(hasWord(msg, "1000000")) << msg;
   expectUsable(ctx.get());
@@ -808,7 +954,10 @@ struct CancelAt {
   size_t cancel_at; // or at this call number (0-based; SIZE_MAX: never)
   size_t calls = 0;
   std::set<int> seen;
-  CancelAt(int s, size_t at) : stage(s), cancel_at(at) {}
+  CancelAt(int s, size_t at)
+      : stage(s)
+      , cancel_at(at)
+  {}
 };
 
 int
@@ -833,8 +982,9 @@ TEST(DacpoInputErrors, CancelledByProgressLeavesNormalsUntouched)
   CancelAt none{-1, SIZE_MAX};
   dacpo_progress prog = {cancelProgress, &none};
   std::vector<float> out = sentinel(c.size());
-  ASSERT_EQ(dacpo_orient(ctx.get(), &p, nullptr, &prog, c.xyz.data(), out.data(), c.size()),
-            DACPO_OK)
+  ASSERT_EQ(
+      dacpo_orient(ctx.get(), &p, nullptr, &prog, c.xyz.data(), out.data(), c.size()),
+      DACPO_OK)
       << lastError(ctx.get());
   // Every stage but DIPOLE, which shares one reported pass with IPSR.
   ASSERT_GE(none.seen.size(), 7u);
@@ -845,21 +995,22 @@ TEST(DacpoInputErrors, CancelledByProgressLeavesNormalsUntouched)
     CancelAt at{stage, SIZE_MAX};
     dacpo_progress pr = {cancelProgress, &at};
     out = sentinel(c.size());
-    std::string msg = expectFailure(ctx.get(), &p, nullptr, &pr, c.xyz.data(), &out,
-                                    c.size(), DACPO_ERR_CANCELLED);
+    std::string msg = expectFailure(
+        ctx.get(), &p, nullptr, &pr, c.xyz.data(), &out, c.size(), DACPO_ERR_CANCELLED);
     EXPECT_NE(msg.find("cancel"), std::string::npos) << msg;
   }
   // Cancelling at the very last report (after the 0-1 program) still writes nothing.
   CancelAt last{-1, none.calls - 1};
   dacpo_progress pr = {cancelProgress, &last};
   out = sentinel(c.size());
-  expectFailure(ctx.get(), &p, nullptr, &pr, c.xyz.data(), &out, c.size(),
-                DACPO_ERR_CANCELLED);
+  expectFailure(
+      ctx.get(), &p, nullptr, &pr, c.xyz.data(), &out, c.size(), DACPO_ERR_CANCELLED);
   EXPECT_EQ(last.calls, none.calls);
   expectUsable(ctx.get());
 }
 
-// ---- status strings, context lifetime ---------------------------------------------------------
+// ---- status strings, context lifetime
+// ---------------------------------------------------------
 
 TEST(DacpoInputErrors, StatusStringsAreDistinct)
 {

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "dacpo_scene.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -18,8 +20,6 @@
 #include <thread>
 #include <utility>
 #include <vector>
-
-#include "dacpo_scene.h"
 
 namespace {
 
@@ -124,8 +124,8 @@ orientScene(const Scene& sc,
             const dacpo_progress* progress = nullptr)
 {
   auto ctx = makeCtx();
-  std::vector<float> in = p.estimate_normals ? std::vector<float>(3 * sc.s.n, 0.0f)
-                                             : scrambled(sc, 7);
+  std::vector<float> in =
+      p.estimate_normals ? std::vector<float>(3 * sc.s.n, 0.0f) : scrambled(sc, 7);
   return orient(ctx.get(), p, sc.s.xyz, std::move(in), sc.s.n, search, progress);
 }
 
@@ -159,7 +159,8 @@ struct BruteForce {
 };
 
 int
-bruteForceKnn(void* user, size_t query, size_t k, int32_t* idx, float* sqd, size_t* found)
+bruteForceKnn(
+    void* user, size_t query, size_t k, int32_t* idx, float* sqd, size_t* found)
 {
   const auto* bf = static_cast<const BruteForce*>(user);
   if (query >= bf->n)
@@ -216,7 +217,8 @@ TEST(DacpoPipeline, OpenBoxScrambledNormals)
   EXPECT_LT(wrong, 1.0);
   EXPECT_EQ(r.stats.num_components, 1u);
   EXPECT_GT(r.stats.num_blocks, 1u) << "the block graph and 0-1 program should be used";
-  EXPECT_TRUE(r.curvature.empty()) << "curvature is only published for estimated normals";
+  EXPECT_TRUE(r.curvature.empty())
+      << "curvature is only published for estimated normals";
 }
 
 TEST(DacpoPipeline, OpenBoxEstimatedNormals)
@@ -280,8 +282,9 @@ TEST(DacpoPipeline, SeedsOneToFiveAgreeOnAGeneratedRoom)
       ASSERT_GE(r.confidence[i], 0.0f) << i;
       ASSERT_LE(r.confidence[i], 1.0f) << i;
     }
-    std::stable_sort(order.begin(), order.end(),
-                     [&](size_t a, size_t b) { return r.confidence[a] < r.confidence[b]; });
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return r.confidence[a] < r.confidence[b];
+    });
     // wrong under the sign that makes most points right
     size_t agree = 0;
     std::vector<bool> right(sc.s.n);
@@ -346,8 +349,9 @@ TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
   for (size_t j = 0; j < n; ++j)
     ASSERT_EQ(r.component[j], (xyz[3 * j] > 50.0f) != first_far ? 1 : 0) << j;
   // each box oriented on its own, one free sign per component
-  EXPECT_LT(dacpo_score_oriented(gt.data(), r.normals.data(), n, r.component.data(), nullptr),
-            1.0);
+  EXPECT_LT(
+      dacpo_score_oriented(gt.data(), r.normals.data(), n, r.component.data(), nullptr),
+      1.0);
 
   // blocks: valid ids, all used, none spanning components, spatially compact
   // (a scrambled order would give each block a random spread of points)
@@ -386,7 +390,8 @@ TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
         s1[a] += sc.s.xyz[3 * i + a];
         s2 += double(sc.s.xyz[3 * i + a]) * sc.s.xyz[3 * i + a];
       }
-    box_spread = 2.0 * (s2 - (s1[0] * s1[0] + s1[1] * s1[1] + s1[2] * s1[2]) / double(half));
+    box_spread =
+        2.0 * (s2 - (s1[0] * s1[0] + s1[1] * s1[1] + s1[2] * s1[2]) / double(half));
   }
   EXPECT_GE(nb, 4u);
   EXPECT_LT(within, 0.75 * box_spread) << "blocks are not spatially compact";
@@ -396,7 +401,8 @@ TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
   double crease_sum = 0.0;
   size_t crease_n = 0, flat_n = 0;
   for (size_t j = 0; j < n; ++j) {
-    const float x[3] = {xyz[3 * j] - (xyz[3 * j] > 50.0f ? 100.0f : 0.0f), xyz[3 * j + 1],
+    const float x[3] = {xyz[3 * j] - (xyz[3 * j] > 50.0f ? 100.0f : 0.0f),
+                        xyz[3 * j + 1],
                         xyz[3 * j + 2]};
     // distance to the second-closest of the five box planes
     double d[5];
@@ -436,7 +442,8 @@ TEST(DacpoPipeline, BlockFlipsAndEdgesAreConsistent)
   }
   EXPECT_EQ(st.flipped_blocks, flipped);
 
-  ASSERT_GE(st.num_block_edges, st.num_blocks - 1) << "one component needs a spanning graph";
+  ASSERT_GE(st.num_block_edges, st.num_blocks - 1)
+      << "one component needs a spanning graph";
   ASSERT_EQ(r.edges.size(), st.num_block_edges);
   std::set<std::pair<int32_t, int32_t>> pairs;
   size_t zero = 0;
@@ -474,7 +481,8 @@ TEST(DacpoPipeline, StageTimesAddUp)
   ASSERT_EQ(r.status, DACPO_OK) << r.error;
   double sum = 0.0;
   for (int s = 0; s < DACPO_STAGE_COUNT; ++s) {
-    EXPECT_GE(r.stats.stage_seconds[s], 0.0) << dacpo_stage_name(static_cast<dacpo_stage>(s));
+    EXPECT_GE(r.stats.stage_seconds[s], 0.0)
+        << dacpo_stage_name(static_cast<dacpo_stage>(s));
     sum += r.stats.stage_seconds[s];
   }
   EXPECT_GT(r.stats.total_seconds, 0.0);
@@ -557,7 +565,8 @@ TEST(DacpoPipeline, CallerSearchMatchesBuiltIn)
   }
 }
 
-// ---- options -------------------------------------------------------------------------
+// ---- options
+// -------------------------------------------------------------------------
 
 // Measured: 0.000 % wrong for every combination below (10K points, given and
 // estimated normals).
@@ -582,7 +591,8 @@ TEST(DacpoPipeline, EdgeWeightsAndIpsrAllSucceed)
   }
 }
 
-// ---- callbacks -----------------------------------------------------------------------
+// ---- callbacks
+// -----------------------------------------------------------------------
 
 TEST(DacpoPipeline, ProgressStagesAreOrdered)
 {
@@ -613,12 +623,16 @@ TEST(DacpoPipeline, ProgressStagesAreOrdered)
     }
     seen.insert(stage);
   }
-  for (int s : {DACPO_STAGE_NEIGHBORS, DACPO_STAGE_NORMALS, DACPO_STAGE_SEGMENT,
-                DACPO_STAGE_IPSR, DACPO_STAGE_EDGE_WEIGHTS})
+  for (int s : {DACPO_STAGE_NEIGHBORS,
+                DACPO_STAGE_NORMALS,
+                DACPO_STAGE_SEGMENT,
+                DACPO_STAGE_IPSR,
+                DACPO_STAGE_EDGE_WEIGHTS})
     EXPECT_EQ(seen.count(s), 1u) << dacpo_stage_name(static_cast<dacpo_stage>(s));
 }
 
-// ---- output form ------------------------------------------------------------------------
+// ---- output form
+// ------------------------------------------------------------------------
 
 TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
 {
@@ -631,8 +645,10 @@ TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
   uint64_t st = 99;
   for (size_t i = 0; i < n; ++i) {
     st = st * 6364136223846793005ull + 1442695040888963407ull;
-    const float scale = 0.01f + 10.0f * static_cast<float>((st >> 40) & 0xFFFF) / 65536.0f;
-    const float tilt = 0.2f * (static_cast<float>((st >> 20) & 0xFFFF) / 65536.0f - 0.5f);
+    const float scale =
+        0.01f + 10.0f * static_cast<float>((st >> 40) & 0xFFFF) / 65536.0f;
+    const float tilt =
+        0.2f * (static_cast<float>((st >> 20) & 0xFFFF) / 65536.0f - 0.5f);
     given[3 * i] = scale * (given[3 * i] + tilt);
     given[3 * i + 1] = scale * (given[3 * i + 1] - tilt);
     given[3 * i + 2] = scale * (given[3 * i + 2] + 0.5f * tilt);
@@ -692,10 +708,11 @@ TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
     }
     const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+    const double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                          e1[2] * e2[0] - e1[0] * e2[2],
                           e1[0] * e2[1] - e1[1] * e2[0]};
-    const double m[3] = {(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3,
-                         (a[2] + b[2] + c[2]) / 3};
+    const double m[3] = {
+        (a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3};
     size_t best = 0;
     double bestd = 1e300;
     for (size_t i = 0; i < sc.s.n; ++i) {
@@ -710,7 +727,8 @@ TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
     const float* on = r.normals.data() + 3 * best;
     agree += fn[0] * on[0] + fn[1] * on[1] + fn[2] * on[2] > 0.0;
   }
-  RecordProperty("agreeing_faces", std::to_string(agree) + "/" + std::to_string(checked));
+  RecordProperty("agreeing_faces",
+                 std::to_string(agree) + "/" + std::to_string(checked));
   EXPECT_GT(static_cast<double>(agree), 0.95 * static_cast<double>(checked));
 
   // Without keep_mesh there is no mesh.

@@ -42,8 +42,8 @@ orientSheets(const Case& c, uint64_t seed)
   const double h = 0.02;
   dacpo_scene sc{};
   char err[256];
-  EXPECT_EQ(dacpo_scene_parallel_sheets(1.0, h, c.gap * h, c.noise * h, seed, &sc, err,
-                                        sizeof(err)),
+  EXPECT_EQ(dacpo_scene_parallel_sheets(
+                1.0, h, c.gap * h, c.noise * h, seed, &sc, err, sizeof(err)),
             0)
       << err;
   std::vector<float> nrm(3 * sc.n, 0.0f);
@@ -55,10 +55,13 @@ orientSheets(const Case& c, uint64_t seed)
   p.seed = seed;
   if (c.c > 0.0)
     p.dipole_c = c.c;
-  const dacpo_status s = dacpo_orient(ctx, &p, nullptr, nullptr, sc.xyz, nrm.data(), sc.n);
+  const dacpo_status s =
+      dacpo_orient(ctx, &p, nullptr, nullptr, sc.xyz, nrm.data(), sc.n);
   EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
   const double wrong =
-      s == DACPO_OK ? dacpo_score_oriented(sc.normals, nrm.data(), sc.n, nullptr, nullptr) : 100.0;
+      s == DACPO_OK
+          ? dacpo_score_oriented(sc.normals, nrm.data(), sc.n, nullptr, nullptr)
+          : 100.0;
   dacpo_ctx_free(ctx);
   dacpo_scene_free(&sc);
   return wrong;
@@ -69,14 +72,19 @@ orientSheets(const Case& c, uint64_t seed)
 TEST(DacpoThinStructures, ParallelSheetsFacingAway)
 {
   const std::vector<Case> cases = {
-      {1.5, 0.0, 0.0, 0.5}, {2.0, 0.0, 0.0, 0.5}, {2.0, 0.3, 0.0, 1.5}, // default c
-      {1.0, 0.0, 4.0, 1.5}, {1.0, 0.3, 4.0, 4.0}, {1.5, 0.3, 4.0, 3.0}, // c = 4
+      {1.5, 0.0, 0.0, 0.5},
+      {2.0, 0.0, 0.0, 0.5},
+      {2.0, 0.3, 0.0, 1.5}, // default c
+      {1.0, 0.0, 4.0, 1.5},
+      {1.0, 0.3, 4.0, 4.0},
+      {1.5, 0.3, 4.0, 3.0}, // c = 4
   };
   for (const Case& c : cases) {
     double worst = 0.0;
     for (uint64_t seed = 1; seed <= 3; ++seed)
       worst = std::max(worst, orientSheets(c, seed));
     RecordProperty("worst_percent", std::to_string(worst));
-    EXPECT_LE(worst, c.bound) << "gap " << c.gap << " noise " << c.noise << " c " << c.c;
+    EXPECT_LE(worst, c.bound) << "gap " << c.gap << " noise " << c.noise << " c "
+                              << c.c;
   }
 }

@@ -1076,7 +1076,8 @@ dacpo_scene_parallel_sheets(double size,
   out->part = malloc(n * sizeof(int32_t));
   out->part_object = malloc(2 * sizeof(int32_t));
   out->object_name = malloc(sizeof(const char*));
-  if (!out->xyz || !out->normals || !out->part || !out->part_object || !out->object_name) {
+  if (!out->xyz || !out->normals || !out->part || !out->part_object ||
+      !out->object_name) {
     dacpo_scene_free(out);
     if (err && errlen)
       snprintf(err, errlen, "parallel sheets: out of memory");

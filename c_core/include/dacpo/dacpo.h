@@ -64,14 +64,14 @@ dacpo_status_string(dacpo_status status);
 
 /** \brief Pipeline stages, in the order they run (used for progress and timings). */
 typedef enum dacpo_stage {
-  DACPO_STAGE_INPUT = 0,      /**< validation, duplicate removal */
-  DACPO_STAGE_NEIGHBORS = 1,  /**< k-NN graph, connected components */
-  DACPO_STAGE_NORMALS = 2,    /**< PCA normals (when none were given) */
-  DACPO_STAGE_SEGMENT = 3,    /**< stage 1: block segmentation, block graph */
-  DACPO_STAGE_DIPOLE = 4,     /**< stage 2: dipole-field initialisation per block */
-  DACPO_STAGE_IPSR = 5,       /**< stage 3: iPSR with Neumann Poisson per block */
+  DACPO_STAGE_INPUT = 0,        /**< validation, duplicate removal */
+  DACPO_STAGE_NEIGHBORS = 1,    /**< k-NN graph, connected components */
+  DACPO_STAGE_NORMALS = 2,      /**< PCA normals (when none were given) */
+  DACPO_STAGE_SEGMENT = 3,      /**< stage 1: block segmentation, block graph */
+  DACPO_STAGE_DIPOLE = 4,       /**< stage 2: dipole-field initialisation per block */
+  DACPO_STAGE_IPSR = 5,         /**< stage 3: iPSR with Neumann Poisson per block */
   DACPO_STAGE_EDGE_WEIGHTS = 6, /**< stage 4: block-pair consistency weights */
-  DACPO_STAGE_ILP = 7,        /**< stage 5: 0-1 program over the block graph */
+  DACPO_STAGE_ILP = 7,          /**< stage 5: 0-1 program over the block graph */
   DACPO_STAGE_COUNT = 8
 } dacpo_stage;
 
@@ -131,32 +131,32 @@ typedef enum dacpo_sign_policy {
  * ever appended.
  */
 typedef struct dacpo_params {
-  size_t k;          /**< k-NN graph size for segmentation/propagation, >= 2 (10) */
-  size_t normal_k;   /**< neighbourhood of PCA normals when estimated (16) */
+  size_t k;             /**< k-NN graph size for segmentation/propagation, >= 2 (10) */
+  size_t normal_k;      /**< neighbourhood of PCA normals when estimated (16) */
   int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
                              0: use the given normals as axes (default 0) */
-  size_t num_blocks; /**< target number of blocks; 0 = automatic:
-                          n/2500 clamped to [1, 200] (default 0) */
-  size_t ring_hops;  /**< overlap ring width in k-NN hops (3) */
-  double dipole_c;   /**< c of paper Eq. 1 (1.5). The paper uses 4 for clean and
-                          2 for noisy scans. Larger c keeps the two sides of
-                          thin structures apart, smaller c resists depth noise.
-                          Measured here (full pipeline): c = 4 left 22.9 % wrong
-                          on the largest components of our 15 real depth frames
-                          and 26 % on a room with noise 0.008; c = 1.5 kept a
-                          2 cm board at 20K points (0.01 % wrong) that c = 1.2
-                          got 9 % wrong. */
-  size_t dipole_orders;    /**< M randomized BFS orders (5) */
-  size_t dipole_neighbors; /**< K nearest placed points summed per decision (32) */
-  int dipole_final_sweep;  /**< re-decision sweeps after voting, repeated until no
-                                point changes, at most this many; 0 = none (10) */
-  int ipsr_enabled;        /**< stage 3 on/off (1) */
+  size_t num_blocks;    /**< target number of blocks; 0 = automatic:
+                             n/2500 clamped to [1, 200] (default 0) */
+  size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
+  double dipole_c;      /**< c of paper Eq. 1 (1.5). The paper uses 4 for clean and
+                             2 for noisy scans. Larger c keeps the two sides of
+                             thin structures apart, smaller c resists depth noise.
+                             Measured here (full pipeline): c = 4 left 22.9 % wrong
+                             on the largest components of our 15 real depth frames
+                             and 26 % on a room with noise 0.008; c = 1.5 kept a
+                             2 cm board at 20K points (0.01 % wrong) that c = 1.2
+                             got 9 % wrong. */
+  size_t dipole_orders; /**< M randomized BFS orders (5) */
+  size_t dipole_neighbors;    /**< K nearest placed points summed per decision (32) */
+  int dipole_final_sweep;     /**< re-decision sweeps after voting, repeated until no
+                                   point changes, at most this many; 0 = none (10) */
+  int ipsr_enabled;           /**< stage 3 on/off (1) */
   size_t ipsr_max_iterations; /**< (20) */
   dacpo_edge_weight edge_weight; /**< (DACPO_WEIGHT_VCR; with iPSR off the blocks
                                        still get one Poisson mesh for it) */
-  double solver_time_limit; /**< seconds for the 0-1 program (30) */
-  uint64_t seed;            /**< all randomness derives from it (1) */
-  unsigned num_threads;     /**< 0 = all cores (0) */
+  double solver_time_limit;      /**< seconds for the 0-1 program (30) */
+  uint64_t seed;                 /**< all randomness derives from it (1) */
+  unsigned num_threads;          /**< 0 = all cores (0) */
   dacpo_disconnected_policy disconnected; /**< (VIEWPOINT) */
   double dipole_noise_band; /**< pairs whose offsets along both normals are
                                  below this many times the block's noise scale
@@ -165,27 +165,27 @@ typedef struct dacpo_params {
                                  Eq. 1; 0 = off, the paper's field (0). With
                                  c = 4 a band of 3 cut the error on a room
                                  with noise 0.008 from 46 % to 10 %. */
-  int keep_mesh; /**< 1: keep the trimmed stage-3 block meshes, wound to agree
-                      with the final (flipped) normals, as one scene mesh; see
-                      dacpo_ctx_mesh() (0) */
-  size_t vcr_image_size;  /**< VCR image side in pixels, in [16, 4096] (400, paper) */
-  size_t vcr_views;       /**< VCR views: 12 = dodecahedron face centres (paper);
-                               other counts use a Fibonacci sphere, [1, 256] (12) */
-  int vcr_perspective;    /**< 1: perspective projection (paper); 0: orthographic (0) */
-  int vcr_boundary_factor; /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
-  size_t dipole_restarts; /**< independent runs of stage 2 per block (M orders
-                               each); the one with the highest block energy
-                               (Eq. 4 summed over all pairs) is kept, 1..64 (4) */
-  double weak_edge_fraction; /**< VIEWPOINT policy: block-graph edges whose
-                                  alpha + alpha-bar is below this fraction of the
-                                  median edge's do not join blocks into one part;
-                                  0 = parts are the k-NN components (1: every
-                                  edge below the median; measured on 15 real
-                                  frames x 5 seeds: worst seed 8.55 % -> 5.75 %
-                                  against 0.1, rooms unchanged) */
+  int keep_mesh;         /**< 1: keep the trimmed stage-3 block meshes, wound to agree
+                              with the final (flipped) normals, as one scene mesh; see
+                              dacpo_ctx_mesh() (0) */
+  size_t vcr_image_size; /**< VCR image side in pixels, in [16, 4096] (400, paper) */
+  size_t vcr_views;      /**< VCR views: 12 = dodecahedron face centres (paper);
+                              other counts use a Fibonacci sphere, [1, 256] (12) */
+  int vcr_perspective;   /**< 1: perspective projection (paper); 0: orthographic (0) */
+  int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
+  size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
+                                      each); the one with the highest block energy
+                                      (Eq. 4 summed over all pairs) is kept, 1..64 (4) */
+  double weak_edge_fraction;     /**< VIEWPOINT policy: block-graph edges whose
+                                      alpha + alpha-bar is below this fraction of the
+                                      median edge's do not join blocks into one part;
+                                      0 = parts are the k-NN components (1: every
+                                      edge below the median; measured on 15 real
+                                      frames x 5 seeds: worst seed 8.55 % -> 5.75 %
+                                      against 0.1, rooms unchanged) */
   dacpo_sign_policy sign_policy; /**< global sign (DACPO_SIGN_FREE_SPACE) */
-  double viewpoint[3]; /**< DACPO_SIGN_VIEWPOINT: the point normals face,
-                            in the input's frame (0, 0, 0) */
+  double viewpoint[3];           /**< DACPO_SIGN_VIEWPOINT: the point normals face,
+                                      in the input's frame (0, 0, 0) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -236,20 +236,20 @@ typedef struct dacpo_progress {
 
 /** \brief What the last run did. Valid until the next run or dacpo_ctx_free(). */
 typedef struct dacpo_stats {
-  size_t input_points;     /**< count given */
-  size_t unique_points;    /**< after merging exact duplicates */
-  size_t duplicate_points; /**< input_points - unique_points */
-  size_t k_used;           /**< k after clamping to unique_points - 1 */
-  int k_clamped;           /**< 1 if k was clamped */
-  size_t num_components;   /**< connected components of the k-NN graph */
+  size_t input_points;      /**< count given */
+  size_t unique_points;     /**< after merging exact duplicates */
+  size_t duplicate_points;  /**< input_points - unique_points */
+  size_t k_used;            /**< k after clamping to unique_points - 1 */
+  int k_clamped;            /**< 1 if k was clamped */
+  size_t num_components;    /**< connected components of the k-NN graph */
   size_t largest_component; /**< points in the largest component */
   size_t num_blocks;
   size_t num_block_edges;
   size_t zero_weight_edges; /**< edges with alpha = alpha-bar = 0 (no information) */
   size_t flipped_blocks;    /**< blocks the 0-1 program flipped */
-  int solver_optimal;       /**< 1 if every component's 0-1 program was proven optimal */
-  double solver_objective;  /**< sum of omega over edges at the chosen flips */
-  size_t ilp_constraints;   /**< rows given to lp_solve (all components) */
+  int solver_optimal;      /**< 1 if every component's 0-1 program was proven optimal */
+  double solver_objective; /**< sum of omega over edges at the chosen flips */
+  size_t ilp_constraints;  /**< rows given to lp_solve (all components) */
   size_t ipsr_iterations_total; /**< summed over blocks */
   size_t ipsr_iterations_max;
   /** Wall time per stage. Stages 2 and 3 run in one parallel pass over the
@@ -278,8 +278,8 @@ typedef struct dacpo_stats {
 /** \brief Diagnostics of one block-graph edge. */
 typedef struct dacpo_edge_info {
   int32_t block_a, block_b; /**< block_a < block_b */
-  double alpha;     /**< consistency with both blocks as they are */
-  double alpha_bar; /**< consistency with one block flipped */
+  double alpha;             /**< consistency with both blocks as they are */
+  double alpha_bar;         /**< consistency with one block flipped */
   double confidence; /**< |alpha - alpha_bar| / (alpha + alpha_bar + eps) in [0,1] */
 } dacpo_edge_info;
 
