@@ -12,17 +12,5 @@ set -euo pipefail
 
 PACKAGES=(python3-open3d libcgal-dev xvfb xauth imagemagick time)
 
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install_bench_deps: all packages present"
-  exit 0
-fi
-
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install_bench_deps: installing ${missing[*]}"
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -q
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+"$(dirname "${BASH_SOURCE[0]}")/apt_install.sh" install_bench_deps --no-install-recommends \
+  "${PACKAGES[@]}"

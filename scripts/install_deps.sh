@@ -14,17 +14,4 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python package and its tests
 )
 
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install_deps: all packages present"
-  exit 0
-fi
-
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install_deps: installing ${missing[*]}"
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -q
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${missing[@]}"
+"$(dirname "${BASH_SOURCE[0]}")/apt_install.sh" install_deps "${PACKAGES[@]}"
