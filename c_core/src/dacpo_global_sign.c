@@ -219,24 +219,6 @@ density_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
   return vx > 0.0 && vy > 0.0 ? cov / sqrt(vx * vy) : 0.0;
 }
 
-/* Facing vote of points (p, n) towards v: sum of sign(n . (v - p)). */
-static double
-facing_vote(
-    const double* p, const double* nrm, size_t m, const double v[3], double* dist)
-{
-  double vote = 0.0, sum = 0.0;
-  for (size_t i = 0; i < m; ++i) {
-    const double d[3] = {v[0] - p[3 * i], v[1] - p[3 * i + 1], v[2] - p[3 * i + 2]};
-    const double f = nrm[3 * i] * d[0] + nrm[3 * i + 1] * d[1] + nrm[3 * i + 2] * d[2];
-    vote += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
-    if (dist)
-      sum += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  }
-  if (dist)
-    *dist = m ? sum / (double)m : 0.0;
-  return vote;
-}
-
 dacpo_status
 dacpo_global_sign(const double* xyz,
                   const double* nrm,
@@ -257,7 +239,8 @@ dacpo_global_sign(const double* xyz,
                 DACPO_ERR_INVALID_ARGUMENT,
                 "viewpoint is not finite");
     memcpy(out->viewpoint, viewpoint, sizeof(out->viewpoint));
-    const double vote = facing_vote(xyz, nrm, n, viewpoint, NULL);
+    double vote, dist;
+    (void)dacpo_view_score(xyz, nrm, NULL, n, viewpoint, &vote, 1, &dist);
     out->flip = vote < 0.0;
     out->facing = n ? 0.5 + 0.5 * fabs(vote) / (double)n : 0.0;
     return DACPO_OK;
@@ -280,7 +263,8 @@ dacpo_global_sign(const double* xyz,
   for (size_t k = 0; k < GS_CANDIDATES; ++k) {
     gs_candidate* c = &cand[k];
     dacpo_view_candidate(&vs, &rng, k, c->v);
-    const double vote = facing_vote(vs.p, vs.n, vs.m, c->v, &c->dist);
+    double vote;
+    (void)dacpo_view_score(vs.p, vs.n, NULL, vs.m, c->v, &vote, 1, &c->dist);
     c->score = fabs(vote) / (double)vs.m;
     c->facing = vote < 0.0 ? -1 : 1;
   }

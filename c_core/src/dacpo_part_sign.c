@@ -41,20 +41,15 @@ enum { DACPO_VIEW_CANDIDATES = 1024 };
 #define DACPO_VIEW_TIE 0.0005
 #endif
 
-/* How well v explains the sample: every part votes with its points (+1 facing
- * v, -1 not) and counts with the absolute value of its vote, since its sign is
- * what is being decided; divided by the sample size (1: every point of every
- * part faces v under its part's best sign). *mean_dist gets the mean distance
- * from v to the sample points. */
-static double
-view_score(const double* sp,
-           const double* sn,
-           const int32_t* sc,
-           size_t m,
-           const double v[3],
-           double* vote,
-           size_t num_parts,
-           double* mean_dist)
+double
+dacpo_view_score(const double* sp,
+                 const double* sn,
+                 const int32_t* sc,
+                 size_t m,
+                 const double v[3],
+                 double* vote,
+                 size_t num_parts,
+                 double* mean_dist)
 {
   memset(vote, 0, num_parts * sizeof(double));
   double dist = 0.0;
@@ -63,7 +58,7 @@ view_score(const double* sp,
     const double* q = sn + 3 * s;
     const double d[3] = {v[0] - p[0], v[1] - p[1], v[2] - p[2]};
     const double f = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
-    vote[sc[s]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
+    vote[sc ? sc[s] : 0] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
     dist += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   }
   double total = 0.0;
@@ -130,7 +125,7 @@ dacpo_part_signs(const double* xyz,
     dacpo_view_candidate(&vs, &rng, k, v);
     double dist;
     const double score =
-        view_score(vs.p, vs.n, vs.part, vs.m, v, vote, num_parts, &dist);
+        dacpo_view_score(vs.p, vs.n, vs.part, vs.m, v, vote, num_parts, &dist);
     if (score > facing + DACPO_VIEW_TIE ||
         (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
       facing = fmax(score, facing);

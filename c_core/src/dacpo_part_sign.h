@@ -52,6 +52,21 @@ dacpo_view_sample_take(const double* xyz,
 void
 dacpo_view_sample_free(dacpo_view_sample* s);
 
+/* How well v explains m points (sp, sn; 3m each): every part votes with its
+ * points (+1 facing v, -1 not, into vote[part], num_parts entries; sc NULL =
+ * all in part 0) and counts with the absolute value of its vote, since its sign
+ * is what is being decided; divided by m (1: every point of every part faces v
+ * under its part's best sign). *mean_dist gets the mean distance from v. */
+double
+dacpo_view_score(const double* sp,
+                 const double* sn,
+                 const int32_t* sc,
+                 size_t m,
+                 const double v[3],
+                 double* vote,
+                 size_t num_parts,
+                 double* mean_dist);
+
 /* Candidate viewpoint k of a sequence that depends only on the sample (rng
  * seeded with dacpo_view_rng_seed): a sample point pushed along either side
  * of its normal by 1/4 .. 2 scene diameters. */
