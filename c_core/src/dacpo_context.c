@@ -94,6 +94,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_restarts = 4;
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
+  p->dipole_two_sheet = 3.0;
 }
 
 static dacpo_status
@@ -188,6 +189,11 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_noise_band must be finite and >= 0 (got %g)",
                      p->dipole_noise_band);
+  if (!(p->dipole_two_sheet >= 0.0) || !isfinite(p->dipole_two_sheet))
+    return bad_field(message,
+                     size,
+                     "dipole_two_sheet must be finite and >= 0 (got %g)",
+                     p->dipole_two_sheet);
   if (p->vcr_image_size < 16 || p->vcr_image_size > 4096)
     return bad_field(message,
                      size,
@@ -420,4 +426,37 @@ dacpo_calloc_array(size_t count, size_t size)
   if (size != 0 && count > SIZE_MAX / size)
     return NULL;
   return calloc(count ? count : 1, size ? size : 1);
+}
+
+/* Quickselect: the k-th smallest of v[0..n) (v is permuted). */
+double
+dacpo_select_kth(double* v, size_t n, size_t k)
+{
+  size_t lo = 0, hi = n - 1;
+  while (lo < hi) {
+    double pivot = v[lo + (hi - lo) / 2];
+    size_t i = lo, j = hi;
+    while (i <= j) {
+      while (v[i] < pivot)
+        ++i;
+      while (v[j] > pivot)
+        --j;
+      if (i <= j) {
+        double t = v[i];
+        v[i] = v[j];
+        v[j] = t;
+        ++i;
+        if (j == 0)
+          break;
+        --j;
+      }
+    }
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      break;
+  }
+  return v[k];
 }

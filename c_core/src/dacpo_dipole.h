@@ -21,6 +21,9 @@ typedef struct dacpo_dipole_params {
                         below noise_band * (the block's median RMS offset of
                         neighbours from a point's tangent plane) count as
                         coplanar: the c term of Eq. 1 is dropped for them */
+  double two_sheet;  /* 0 = off; else pairs on two sheets of one thin part
+                        (offsets beyond two_sheet x local noise, see
+                        dacpo_params.dipole_two_sheet) must face opposite ways */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for

@@ -60,6 +60,10 @@ dacpo_rng_below(dacpo_rng* rng, size_t n);
 double
 dacpo_now(void);
 
+/* Quickselect: the k-th smallest of v[0..n), n > 0, k < n (v is permuted). */
+double
+dacpo_select_kth(double* v, size_t n, size_t k);
+
 /* A triangle mesh. Winding is counter-clockwise seen from the side the
  * (oriented) normals point to: the face normal (v1-v0)x(v2-v0) agrees with the
  * block's point normals. */

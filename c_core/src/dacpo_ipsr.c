@@ -176,39 +176,6 @@ ensure_vertices(ipsr_work* w, size_t nv)
   return 1;
 }
 
-/* Quickselect: the k-th smallest of v[0..n) (v is permuted). */
-static double
-select_kth(double* v, size_t n, size_t k)
-{
-  size_t lo = 0, hi = n - 1;
-  while (lo < hi) {
-    double pivot = v[lo + (hi - lo) / 2];
-    size_t i = lo, j = hi;
-    while (i <= j) {
-      while (v[i] < pivot)
-        ++i;
-      while (v[j] > pivot)
-        --j;
-      if (i <= j) {
-        double t = v[i];
-        v[i] = v[j];
-        v[j] = t;
-        ++i;
-        if (j == 0)
-          break;
-        --j;
-      }
-    }
-    if (k <= j)
-      hi = j;
-    else if (k >= i)
-      lo = i;
-    else
-      break;
-  }
-  return v[k];
-}
-
 /* Mean of the m largest values of v[0..n) (min-heap of size m). */
 static double
 mean_of_largest(const double* v, size_t n, size_t m, double* heap)
@@ -272,7 +239,7 @@ estimate_spacing(
     w->area[i] = got > 1 ? 3.14159265358979323846 * r2 / (double)(got - 1) : 0.0;
     tmp[i] = w->area[i];
   }
-  double med = select_kth(tmp, n, n / 2);
+  double med = dacpo_select_kth(tmp, n, n / 2);
   free(tmp);
   if (!(med > 0.0) || !isfinite(med)) {
     /* Mostly coincident samples: fall back on the box diagonal. */

@@ -228,6 +228,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.seed = s->p.seed;
   dp.stream = (uint64_t)b;
   dp.noise_band = s->p.dipole_noise_band;
+  dp.two_sheet = s->p.dipole_two_sheet;
   dp.restarts = s->p.dipole_restarts;
   double t0 = dacpo_now();
   st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);
@@ -291,6 +292,7 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
                         &vp,
                         &edge->alpha,
                         &edge->alpha_bar,
+                        NULL,
                         err);
 }
 

@@ -674,24 +674,27 @@ run_view(vcr_work* w,
 }
 
 dacpo_status
-dacpo_vcr_edge_debug(const dacpo_mesh* a,
-                     const dacpo_mesh* b,
-                     const dacpo_vcr_params* params,
-                     double* alpha,
-                     double* alpha_bar,
-                     dacpo_vcr_view_stats* views,
-                     uint8_t* images,
-                     dacpo_err* err)
+dacpo_vcr_edge(const dacpo_mesh* a,
+               const dacpo_mesh* b,
+               const dacpo_vcr_params* params,
+               double* alpha,
+               double* alpha_bar,
+               dacpo_vcr_trace* trace,
+               dacpo_err* err)
 {
+  DACPO_CHECK(err,
+              alpha != NULL && alpha_bar != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: alpha and alpha_bar must not be NULL");
+  dacpo_vcr_view_stats* views = trace ? trace->views : NULL;
+  uint8_t* images = trace ? trace->images : NULL;
   dacpo_vcr_params prm;
   if (params != NULL)
     prm = *params;
   else
     dacpo_vcr_params_default(&prm);
-  if (alpha != NULL)
-    *alpha = 0.0;
-  if (alpha_bar != NULL)
-    *alpha_bar = 0.0;
+  *alpha = 0.0;
+  *alpha_bar = 0.0;
   DACPO_CHECK(err,
               prm.image_size >= 8 && prm.image_size <= VCR_MAX_IMAGE,
               DACPO_ERR_INVALID_ARGUMENT,
@@ -819,24 +822,7 @@ dacpo_vcr_edge_debug(const dacpo_mesh* a,
   }
   free(dirs);
   work_free(&w);
-  if (alpha != NULL)
-    *alpha = sum_a;
-  if (alpha_bar != NULL)
-    *alpha_bar = sum_b;
+  *alpha = sum_a;
+  *alpha_bar = sum_b;
   return DACPO_OK;
-}
-
-dacpo_status
-dacpo_vcr_edge(const dacpo_mesh* a,
-               const dacpo_mesh* b,
-               const dacpo_vcr_params* params,
-               double* alpha,
-               double* alpha_bar,
-               dacpo_err* err)
-{
-  DACPO_CHECK(err,
-              alpha != NULL && alpha_bar != NULL,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: alpha and alpha_bar must not be NULL");
-  return dacpo_vcr_edge_debug(a, b, params, alpha, alpha_bar, NULL, NULL, err);
 }

@@ -40,12 +40,14 @@ dacpo_vcr_params_default(dacpo_vcr_params* p);
  * alpha and alpha_bar exactly. Empty meshes: both 0, DACPO_OK. Errors:
  * DACPO_ERR_INVALID_ARGUMENT (bad parameter, vertex index out of range,
  * non-finite vertex), DACPO_ERR_OUT_OF_MEMORY. Thread-safe: scratch is per call.) */
+typedef struct dacpo_vcr_trace dacpo_vcr_trace; /* optional diagnostics, below */
 dacpo_status
 dacpo_vcr_edge(const dacpo_mesh* a,
                const dacpo_mesh* b,
                const dacpo_vcr_params* params,
                double* alpha,
                double* alpha_bar,
+               dacpo_vcr_trace* trace,
                dacpo_err* err);
 
 /* ---- additions (stage 4) ------------------------------------------------ */
@@ -73,7 +75,7 @@ typedef struct dacpo_vcr_view_stats {
   size_t gap_pixels; /* seam-closing radius used in this view */
 } dacpo_vcr_view_stats;
 
-/* Label codes written to dacpo_vcr_edge_debug's images. */
+/* Label codes written to a dacpo_vcr_trace's images. */
 #define DACPO_VCR_PIXEL_EMPTY 0
 #define DACPO_VCR_PIXEL_A_FRONT 1 /* mesh a, face normal towards the camera */
 #define DACPO_VCR_PIXEL_A_BACK 2
@@ -83,18 +85,13 @@ typedef struct dacpo_vcr_view_stats {
   8 /* or-ed in: has a depth-continuous                                                \
        4-neighbour of the other mesh */
 
-/* dacpo_vcr_edge plus, optionally, per-view statistics (views: NULL or
- * params->num_views entries) and label images (images: NULL or num_views *
- * image_size * image_size bytes, row-major, codes above; views that draw
- * nothing stay 0). alpha/alpha_bar may be NULL here. */
-dacpo_status
-dacpo_vcr_edge_debug(const dacpo_mesh* a,
-                     const dacpo_mesh* b,
-                     const dacpo_vcr_params* params,
-                     double* alpha,
-                     double* alpha_bar,
-                     dacpo_vcr_view_stats* views,
-                     uint8_t* images,
-                     dacpo_err* err);
+/* What dacpo_vcr_edge can report besides alpha / alpha_bar (trace NULL: nothing):
+ * per-view statistics (views: NULL or params->num_views entries) and label
+ * images (images: NULL or num_views * image_size * image_size bytes, row-major,
+ * codes above; views that draw nothing stay 0). */
+struct dacpo_vcr_trace {
+  dacpo_vcr_view_stats* views;
+  uint8_t* images;
+};
 
 #endif

@@ -66,7 +66,7 @@ time_edge(const dacpo_mesh* a,
   double best = INFINITY;
   for (int r = 0; r < reps; ++r) {
     double t0 = cpu_now();
-    if (dacpo_vcr_edge(a, b, p, alpha, alpha_bar, &err) != DACPO_OK) {
+    if (dacpo_vcr_edge(a, b, p, alpha, alpha_bar, NULL, &err) != DACPO_OK) {
       fprintf(stderr, "error: %s\n", err.msg);
       return -1;
     }

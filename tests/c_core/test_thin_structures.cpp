@@ -6,21 +6,28 @@
 // worst of seeds 1-3) with a small margin.
 //
 // Measured worst of seeds 1-3, % wrong:
-//   gap (spacings)      1.0     1.5     2.0
-//   c = 1.5 clean     50.00    0.23    0.13
-//   c = 1.5 noisy     50.00   25.12    0.62
-//   c = 4   clean      0.83    0.23    0.13
-//   c = 4   noisy      2.73    1.56    0.62
-//   c = 8   noisy      2.83   17.17   41.08
-// With the default c = 1.5 (chosen for noisy depth frames) a gap of one
-// spacing reads as one noisy sheet and both faces get one sign; c = 4 resolves
-// every case here but costs the noisy real frames. The cases below pin what
-// works; the default's failures are listed above, not asserted as passes.
+//   gap (spacings)                1.0     1.5     2.0
+//   c = 1.5 clean (two_sheet 0)  50.00    0.23    0.13
+//   c = 1.5 noisy (two_sheet 0)  50.00   25.12    0.62
+//   default clean (two-sheet)     0.83    0.23    0.13
+//   default noisy (two-sheet)     4.17    1.42    0.62
+//   c = 4   clean                 0.83    0.23    0.13
+//   c = 4   noisy                 2.83    1.54    0.62
+//   c = 8   noisy                 2.83   17.17   41.08
+// With c = 1.5 alone (chosen for noisy depth frames) a gap of one spacing reads
+// as one noisy sheet and both faces get one sign; the two-sheet rule of stage 2
+// (dacpo_params.dipole_two_sheet) resolves every case here at c = 1.5.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
+
+#define BOUND_BOARD 100.0
+#define BOUND_TABLE 100.0
+#define BOUND_TUBE 100.0
+#define BOUND_PARTITION 100.0
 
 extern "C" {
 #include "dacpo/dacpo.h"
@@ -36,16 +43,11 @@ struct Case {
   double bound; // % wrong, worst of seeds 1-3
 };
 
+// % wrong (after the metric's one global flip) of a scene oriented from
+// unsigned PCA normals (c: dipole c, 0 = the default); frees the scene.
 double
-orientSheets(const Case& c, uint64_t seed)
+orientAndScore(dacpo_scene& sc, double c, uint64_t seed)
 {
-  const double h = 0.02;
-  dacpo_scene sc{};
-  char err[256];
-  EXPECT_EQ(dacpo_scene_parallel_sheets(
-                1.0, h, c.gap * h, c.noise * h, seed, &sc, err, sizeof(err)),
-            0)
-      << err;
   std::vector<float> nrm(3 * sc.n, 0.0f);
   dacpo_ctx* ctx = nullptr;
   EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
@@ -53,8 +55,8 @@ orientSheets(const Case& c, uint64_t seed)
   dacpo_params_init(&p);
   p.estimate_normals = 1;
   p.seed = seed;
-  if (c.c > 0.0)
-    p.dipole_c = c.c;
+  if (c > 0.0)
+    p.dipole_c = c;
   const dacpo_status s =
       dacpo_orient(ctx, &p, nullptr, nullptr, sc.xyz, nrm.data(), sc.n);
   EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
@@ -67,14 +69,30 @@ orientSheets(const Case& c, uint64_t seed)
   return wrong;
 }
 
+double
+orientSheets(const Case& c, uint64_t seed)
+{
+  const double h = 0.02;
+  dacpo_scene sc{};
+  char err[256];
+  EXPECT_EQ(dacpo_scene_parallel_sheets(
+                1.0, h, c.gap * h, c.noise * h, seed, &sc, err, sizeof(err)),
+            0)
+      << err;
+  return orientAndScore(sc, c.c, seed);
+}
+
 } // namespace
 
 TEST(DacpoThinStructures, ParallelSheetsFacingAway)
 {
   const std::vector<Case> cases = {
+      {1.0, 0.0, 0.0, 1.5},
       {1.5, 0.0, 0.0, 0.5},
       {2.0, 0.0, 0.0, 0.5},
-      {2.0, 0.3, 0.0, 1.5}, // default c
+      {1.0, 0.3, 0.0, 5.5},
+      {1.5, 0.3, 0.0, 2.5},
+      {2.0, 0.3, 0.0, 1.5}, // defaults (two-sheet rule)
       {1.0, 0.0, 4.0, 1.5},
       {1.0, 0.3, 4.0, 4.0},
       {1.5, 0.3, 4.0, 3.0}, // c = 4
@@ -86,5 +104,65 @@ TEST(DacpoThinStructures, ParallelSheetsFacingAway)
     RecordProperty("worst_percent", std::to_string(worst));
     EXPECT_LE(worst, c.bound) << "gap " << c.gap << " noise " << c.noise << " c "
                               << c.c;
+  }
+}
+
+namespace {
+
+struct SceneCase {
+  unsigned kind;
+  size_t points; // nominal spacing = sqrt(area / points), see below
+  double noise;  // sigma in metres
+  double bound;  // % wrong, worst of seeds 1-3, default parameters
+};
+
+// % wrong (after the metric's one global flip) of a generated scene oriented
+// from unsigned PCA normals with the default parameters.
+double
+orientScene(const SceneCase& c, uint64_t seed)
+{
+  dacpo_scene_params sp;
+  dacpo_scene_params_init(&sp);
+  sp.kind = c.kind;
+  sp.target_points = c.points;
+  sp.noise_sigma = c.noise;
+  sp.seed = seed;
+  dacpo_scene sc{};
+  char err[256];
+  EXPECT_EQ(dacpo_scene_generate(&sp, &sc, err, sizeof(err)), 0) << err;
+  return orientAndScore(sc, 0.0, seed);
+}
+
+} // namespace
+
+// Whole thin objects, every face sampled (area / points = spacing^2):
+//   closed board 1.0 x 0.6 x 0.02 m (1.26 m^2)        5,600 points: 1.5 cm
+//   table on a floor, 2 cm top (7.0 m^2)              31,000 points: 1.5 cm
+//   open tube, 2 cm wall (0.91 m^2)                    6,300 points: 1.2 cm
+//   2 cm partition between two walls (34.3 m^2)       55,000 points: 2.5 cm
+// so the faces of each thin part are 0.8-1.7 spacings apart (random sampling:
+// 1.6-3.4 nearest-neighbour distances).
+// Measured worst of seeds 1-3, % wrong (defaults):
+//   board 49.89, table 15.70, tube 49.67, partition 10.77
+// The board and the tube are not solved: PCA normals from 16 neighbours that
+// straddle both faces tilt by ~27 degrees there, and at 2.7 nearest-neighbour
+// distances the faces lie beyond the two-sheet rule's reach; one face comes
+// out reversed. Those two are recorded, not asserted as passes.
+TEST(DacpoThinStructures, ThinObjects)
+{
+  const std::vector<SceneCase> cases = {
+      {DACPO_SCENE_TABLE, 31000, 0.0, 17.0},
+      {DACPO_SCENE_PARTITION, 55000, 0.0, 12.0},
+  };
+  for (const SceneCase& c : cases) {
+    double worst = 0.0;
+    for (uint64_t seed = 1; seed <= 3; ++seed)
+      worst = std::max(worst, orientScene(c, seed));
+    RecordProperty(std::string("worst_percent_") + dacpo_scene_kind_name(c.kind),
+                   std::to_string(worst));
+    printf("%-10s worst of seeds 1-3: %.2f %% wrong\n",
+           dacpo_scene_kind_name(c.kind),
+           worst);
+    EXPECT_LE(worst, c.bound) << dacpo_scene_kind_name(c.kind);
   }
 }

@@ -109,7 +109,8 @@ edge(Mesh& a, Mesh& b, const dacpo_vcr_params* prm = nullptr)
   dacpo_mesh ma = a.view(), mb = b.view();
   Result r;
   dacpo_err err{};
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, prm, &r.alpha, &r.alpha_bar, &err), DACPO_OK)
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, prm, &r.alpha, &r.alpha_bar, nullptr, &err),
+            DACPO_OK)
       << err.msg;
   return r;
 }
@@ -295,6 +296,21 @@ name(const dacpo_vcr_params& p)
 
 } // namespace
 
+// dacpo_vcr_edge with its optional trace filled (per-view statistics, images).
+static dacpo_status
+vcr_edge_traced(const dacpo_mesh* a,
+                const dacpo_mesh* b,
+                const dacpo_vcr_params* p,
+                double* alpha,
+                double* alpha_bar,
+                dacpo_vcr_view_stats* views,
+                uint8_t* images,
+                dacpo_err* err)
+{
+  dacpo_vcr_trace trace{views, images};
+  return dacpo_vcr_edge(a, b, p, alpha, alpha_bar, &trace, err);
+}
+
 TEST(DacpoVcr, Defaults)
 {
   dacpo_vcr_params p;
@@ -345,7 +361,7 @@ TEST(DacpoVcr, EmptyMeshesGiveNoEvidence)
     dacpo_mesh ma = pair->view(), me = e.view();
     double al = -1, ab = -1;
     dacpo_err err{};
-    EXPECT_EQ(dacpo_vcr_edge(&ma, &me, nullptr, &al, &ab, &err), DACPO_OK);
+    EXPECT_EQ(dacpo_vcr_edge(&ma, &me, nullptr, &al, &ab, nullptr, &err), DACPO_OK);
     EXPECT_EQ(al, 0.0);
     EXPECT_EQ(ab, 0.0);
   }
@@ -358,30 +374,33 @@ TEST(DacpoVcr, RejectsBadInput)
   dacpo_mesh ma = a.view(), mb = b.view();
   double al, ab;
   dacpo_err err{};
-  EXPECT_EQ(dacpo_vcr_edge(nullptr, &mb, nullptr, &al, &ab, &err),
+  EXPECT_EQ(dacpo_vcr_edge(nullptr, &mb, nullptr, &al, &ab, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, nullptr, &ab, &err),
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, nullptr, &ab, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
   dacpo_vcr_params p;
   dacpo_vcr_params_default(&p);
   p.image_size = 2;
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("image_size"), std::string::npos) << err.msg;
   dacpo_vcr_params_default(&p);
   p.num_views = 0;
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   dacpo_vcr_params_default(&p);
   p.perspective = 3;
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, &p, &al, &ab, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
   b.t[7] = 1000;
   mb = b.view();
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, &al, &ab, &err),
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, &al, &ab, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("triangle 2"), std::string::npos) << err.msg;
   b.t[7] = 1;
   b.v[4] = NAN;
   mb = b.view();
-  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, &al, &ab, &err),
+  EXPECT_EQ(dacpo_vcr_edge(&ma, &mb, nullptr, &al, &ab, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
 }
 
@@ -481,7 +500,7 @@ TEST(DacpoVcr, SeamBetweenMeshesIsClosedByGapFill)
   dacpo_mesh ma = a.view(), mb = b.view();
   Result wide;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_vcr_edge_debug(
+  ASSERT_EQ(vcr_edge_traced(
                 &ma, &mb, &p, &wide.alpha, &wide.alpha_bar, st.data(), nullptr, &err),
             DACPO_OK);
   EXPECT_GT(wide.alpha, 0.0);
@@ -551,7 +570,7 @@ TEST(DacpoVcr, EtaIsTheLargestDepthSpanOfAVisibleTriangle)
   std::vector<dacpo_vcr_view_stats> st(12);
   double al, ab;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_vcr_edge_debug(&ma, &mb, nullptr, &al, &ab, st.data(), nullptr, &err),
+  ASSERT_EQ(vcr_edge_traced(&ma, &mb, nullptr, &al, &ab, st.data(), nullptr, &err),
             DACPO_OK);
   std::vector<double> dirs(36);
   dacpo_vcr_view_directions(12, dirs.data());
@@ -589,7 +608,7 @@ TEST(DacpoVcr, DebugImagesAndStatsAgreeWithAlpha)
   std::vector<uint8_t> img(12 * 100 * 100);
   double al, ab;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_vcr_edge_debug(&ma, &mb, &p, &al, &ab, st.data(), img.data(), &err),
+  ASSERT_EQ(vcr_edge_traced(&ma, &mb, &p, &al, &ab, st.data(), img.data(), &err),
             DACPO_OK);
   double sa = 0, sb = 0;
   size_t regions = 0;
@@ -628,7 +647,7 @@ TEST(DacpoVcr, ConcurrentCallsGiveTheSameAnswer)
     th.emplace_back([&, i] {
       dacpo_mesh ma = a.view(), mb = b.view();
       dacpo_err err{};
-      dacpo_vcr_edge(&ma, &mb, nullptr, &r[i].alpha, &r[i].alpha_bar, &err);
+      dacpo_vcr_edge(&ma, &mb, nullptr, &r[i].alpha, &r[i].alpha_bar, nullptr, &err);
     });
   for (auto& t : th)
     t.join();

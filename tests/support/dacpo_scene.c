@@ -627,6 +627,56 @@ scene_box_open(scene_builder* b)
   add_room_walls(b, 0, 0, 4, 3, 2.5, walls);
 }
 
+/* Table on a floor (thin-structure known answer): 2.4 x 2 m floor, a 1.2 x 0.7
+ * m top 2 cm thick at 0.72-0.74 m (all six faces), four 4 x 4 cm legs. The
+ * floor under the legs is not sampled (buried). */
+static void
+scene_table_on_floor(scene_builder* b)
+{
+  const double leg = 0.04, x0 = 0.6, y0 = 0.65, x1 = 1.8, y1 = 1.35, z0 = 0.72;
+  begin_object(b, "floor");
+  scene_prim* floor = quad(b, 0, 0, 0, 2.4, 0, 0, 0, 2.0, 0, 0, 0, 1);
+  begin_object(b, "table");
+  add_box(b, x0, y0, z0, x1, y1, z0 + 0.02, 0);
+  for (int i = 0; i < 4; ++i) {
+    const double lx = (i & 1) ? x1 - 0.05 - leg : x0 + 0.05;
+    const double ly = (i & 2) ? y1 - 0.05 - leg : y0 + 0.05;
+    add_box(b, lx, ly, 0.0, lx + leg, ly + leg, z0, FACE_PZ | FACE_NZ);
+    add_hole(b, floor, lx, lx + leg, ly, ly + leg);
+  }
+}
+
+/* Free-standing open tube (a bin or lamp shade without bottom): outer radius
+ * 0.15 m, wall 2 cm, 0.5 m tall; outer face, inner face (normals towards the
+ * axis, into the free space inside) and both rims. */
+static void
+scene_tube(scene_builder* b)
+{
+  const double r1 = 0.15, r0 = 0.13, h = 0.5;
+  begin_object(b, "tube");
+  add_vcylinder(b, 0, 0, 0, r1, h, 1.0);
+  add_vcylinder(b, 0, 0, 0, r0, h, -1.0);
+  add_hannulus(b, 0, 0, h, r0, r1, 1.0);
+  add_hannulus(b, 0, 0, 0, r0, r1, -1.0);
+}
+
+/* A 2 cm partition standing on the floor between two walls that face each
+ * other: 4 x 3 m floor, inner faces of the walls x = 0 and x = 4 (2.5 m), the
+ * partition x in [1.99, 2.01], y in [0.5, 2.5], 1.8 m tall (both faces, top
+ * and ends; its foot on the floor is buried). */
+static void
+scene_partition(scene_builder* b)
+{
+  begin_object(b, "floor");
+  scene_prim* floor = quad(b, 0, 0, 0, 4, 0, 0, 0, 3, 0, 0, 0, 1);
+  add_hole(b, floor, 1.99, 2.01, 0.5, 2.5);
+  begin_object(b, "walls");
+  quad(b, 0, 0, 0, 0, 3, 0, 0, 0, 2.5, 1, 0, 0);
+  quad(b, 4, 0, 0, 0, 3, 0, 0, 0, 2.5, -1, 0, 0);
+  begin_object(b, "partition");
+  add_box(b, 1.99, 0.5, 0.0, 2.01, 2.5, 1.8, FACE_NZ);
+}
+
 typedef struct scene_entry {
   const char* name;
   void (*build)(scene_builder*);
@@ -641,6 +691,9 @@ static const scene_entry scene_table[DACPO_SCENE_KIND_COUNT] = {
     {"half_cylinder", scene_half_cylinder},
     {"s_sheet", scene_s_sheet},
     {"box", scene_box_open},
+    {"table", scene_table_on_floor},
+    {"tube", scene_tube},
+    {"partition", scene_partition},
 };
 
 /* ------------------------------------------------------------------------- */

@@ -59,7 +59,17 @@ typedef enum dacpo_scene_kind {
   /** Open box room 4 x 3 x 2.5 m, x in [0, 4], y in [0, 3]: floor and the inner
    *  faces of four walls (5 parts), no ceiling. */
   DACPO_SCENE_BOX_OPEN = 7,
-  DACPO_SCENE_KIND_COUNT = 8
+  /** Thin-structure known answers (z up, normals out of the solids, into the
+   *  room for floor and walls). Table on a 2.4 x 2 m floor: 1.2 x 0.7 m top
+   *  2 cm thick at 0.72 m (all faces), four 4 x 4 cm legs. */
+  DACPO_SCENE_TABLE = 8,
+  /** Free-standing open tube: outer radius 0.15 m, 2 cm wall, 0.5 m tall; outer
+   *  and inner faces and both rims. */
+  DACPO_SCENE_TUBE = 9,
+  /** 2 cm partition (2 x 1.8 m, both faces, top, ends) standing on a 4 x 3 m
+   *  floor midway between two walls that face each other. */
+  DACPO_SCENE_PARTITION = 10,
+  DACPO_SCENE_KIND_COUNT = 11
 } dacpo_scene_kind;
 
 /** \brief Room scene dimensions (DACPO_SCENE_ROOM), metres. */

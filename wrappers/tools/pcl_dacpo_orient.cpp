@@ -172,6 +172,14 @@ printHelp(int, char** argv)
       "                     -band X     = dipole noise band, 0 = off (default: ");
   print_value("%g", d.dipole_noise_band);
   print_info(")\n");
+  print_info(
+      "                     -two_sheet X = thin parts: neighbours off each other's "
+      "tangent plane by\n"
+      "                                   more than X times the local noise are two "
+      "sheets that\n"
+      "                                   face opposite ways, 0 = off (default: ");
+  print_value("%g", d.dipole_two_sheet);
+  print_info(")\n");
   print_info("                     -orders X   = randomized dipole propagation orders "
              "(default: ");
   print_value("%zu", d.dipole_orders);
@@ -695,7 +703,8 @@ parseOptions(int argc, char** argv, Options& o)
                 ring = o.params.ring_hops, seed = o.params.seed,
                 threads = o.params.num_threads, restarts = o.params.dipole_restarts;
   double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
-         band = o.params.dipole_noise_band, weak = o.params.weak_edge_fraction;
+         band = o.params.dipole_noise_band, weak = o.params.weak_edge_fraction,
+         two_sheet = o.params.dipole_two_sheet;
   if (!dacpo_tool::parseUnsigned(argc, argv, "-vcr_size", vcr_size, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-vcr_views", vcr_views, error) ||
       !dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
@@ -708,6 +717,7 @@ parseOptions(int argc, char** argv, Options& o)
       !dacpo_tool::parseUnsigned(argc, argv, "-threads", threads, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-c", c, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-band", band, error) ||
+      !dacpo_tool::parseDouble(argc, argv, "-two_sheet", two_sheet, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-weak", weak, error) ||
       !dacpo_tool::parseDouble(argc, argv, "-time_limit", time_limit, error)) {
     print_error("Error: %s\n", error.c_str());
@@ -728,6 +738,7 @@ parseOptions(int argc, char** argv, Options& o)
   o.params.num_threads = static_cast<unsigned>(threads);
   o.params.dipole_c = c;
   o.params.dipole_noise_band = band;
+  o.params.dipole_two_sheet = two_sheet;
   o.params.weak_edge_fraction = weak;
   o.params.vcr_image_size = vcr_size;
   o.params.vcr_views = vcr_views;
@@ -997,6 +1008,7 @@ main(int argc, char** argv)
                                      "-orders",
                                      "-restarts",
                                      "-band",
+                                     "-two_sheet",
                                      "-weak",
                                      "-weights",
                                      "-vcr_size",

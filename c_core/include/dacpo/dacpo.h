@@ -186,6 +186,14 @@ typedef struct dacpo_params {
   dacpo_sign_policy sign_policy; /**< global sign (DACPO_SIGN_FREE_SPACE) */
   double viewpoint[3];           /**< DACPO_SIGN_VIEWPOINT: the point normals face,
                                       in the input's frame (0, 0, 0) */
+  double dipole_two_sheet;       /**< stage 2, thin two-sided parts: a neighbour pair
+                                      with near-parallel axes, each point lying off
+                                      the other's tangent plane by more than this many
+                                      times the local noise and 0.5 to 2 spacings, on
+                                      one side of a point and all around beneath it,
+                                      is the two faces of one thin part and must face
+                                      opposite ways (Eq. 1 alone aligns them for c < 3).
+                                      0 = off, the paper's field (3) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

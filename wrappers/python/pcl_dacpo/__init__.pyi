@@ -43,6 +43,7 @@ def orient(
     num_threads: int = ...,
     disconnected: Union[str, int] = ...,
     dipole_noise_band: float = ...,
+    dipole_two_sheet: float = ...,
     vcr_image_size: int = ...,
     vcr_views: int = ...,
     vcr_perspective: bool = ...,
