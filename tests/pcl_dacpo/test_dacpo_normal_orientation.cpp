@@ -23,6 +23,7 @@
 #include <vector>
 
 namespace {
+using Orientation = pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal>;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
@@ -134,7 +135,7 @@ TEST(DACPONormalOrientation, OrientsOpenBoxWithEstimatedNormals)
   pcl::PointCloud<pcl::Normal> out;
   dacpo.compute(out);
   ASSERT_EQ(out.size(), scene.cloud->size());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::OK);
   EXPECT_TRUE(out.is_dense);
   for (const auto& n : out)
     ASSERT_TRUE(isUnit(n));
@@ -303,14 +304,14 @@ TEST(DACPONormalOrientation, RadiusSearchIsRejected)
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(out.width, 0u);
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::InvalidArgument);
   EXPECT_FALSE(dacpo.getLastError().empty());
 
   // radius and k both set: PCL's initCompute rejects it before the class runs
   dacpo.setKSearch(10);
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::InvalidArgument);
   EXPECT_NE(dacpo.getLastError().find("radius"), std::string::npos)
       << dacpo.getLastError();
 
@@ -318,7 +319,7 @@ TEST(DACPONormalOrientation, RadiusSearchIsRejected)
   dacpo.setRadiusSearch(0.0);
   skipIPSR(dacpo);
   dacpo.compute(out);
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::OK);
   EXPECT_TRUE(dacpo.getLastError().empty());
 }
 
@@ -332,7 +333,7 @@ TEST(DACPONormalOrientation, EmptyCloudGivesEmptyOutput)
   out.resize(5);
   dacpo.compute(out); // PCL's initCompute rejects it; the class says why
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_EMPTY_INPUT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::EmptyInput);
   EXPECT_NE(dacpo.getLastError().find("empty"), std::string::npos)
       << dacpo.getLastError();
 
@@ -344,7 +345,7 @@ TEST(DACPONormalOrientation, EmptyCloudGivesEmptyOutput)
   dacpo.setInputCloud(nan_only);
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_EMPTY_INPUT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::EmptyInput);
 }
 
 TEST(DACPONormalOrientation, TwoFarApartClustersAreTwoComponents)
@@ -367,11 +368,11 @@ TEST(DACPONormalOrientation, TwoFarApartClustersAreTwoComponents)
   EXPECT_EQ(labels.back(), 1);
   EXPECT_LT(wrongPercent(a.gt, out, &labels), 2.0);
 
-  dacpo.setDisconnectedPolicy(DACPO_DISCONNECTED_ERROR);
-  EXPECT_EQ(dacpo.getDisconnectedPolicy(), DACPO_DISCONNECTED_ERROR);
+  dacpo.setDisconnectedPolicy(Orientation::DisconnectedPolicy::Error);
+  EXPECT_EQ(dacpo.getDisconnectedPolicy(), Orientation::DisconnectedPolicy::Error);
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_DISCONNECTED);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::Disconnected);
 }
 
 pcl::PointCloud<pcl::Normal>
@@ -423,7 +424,7 @@ TEST(DACPONormalOrientation, SearchExceptionsDoNotCrossTheCBoundary)
   pcl::PointCloud<pcl::Normal> out;
   EXPECT_NO_THROW(dacpo.compute(out));
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_NEIGHBOR_SEARCH);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::NeighborSearch);
   EXPECT_NE(dacpo.getLastError().find("search exploded"), std::string::npos)
       << dacpo.getLastError();
 }
@@ -451,7 +452,7 @@ TEST(DACPONormalOrientation, ProgressCallbackCanCancel)
       [](dacpo_stage stage, double) { return stage < DACPO_STAGE_SEGMENT; });
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_CANCELLED);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::Cancelled);
 
   dacpo.setProgressCallback([](dacpo_stage, double) -> bool {
     throw std::runtime_error("progress exploded");
@@ -471,7 +472,7 @@ TEST(DACPONormalOrientation, BadParametersAndNormalsSizeAreReported)
   pcl::PointCloud<pcl::Normal> out;
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::InvalidArgument);
   EXPECT_NE(dacpo.getLastError().find("dipole_c"), std::string::npos)
       << dacpo.getLastError();
 
@@ -481,7 +482,7 @@ TEST(DACPONormalOrientation, BadParametersAndNormalsSizeAreReported)
   dacpo.setInputNormals(few);
   dacpo.compute(out);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(dacpo.getLastStatus(), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo.getLastStatus(), Orientation::Status::InvalidArgument);
   dacpo.resetInputNormals();
   dacpo.compute(out);
   EXPECT_EQ(out.size(), scene.cloud->size());
@@ -498,12 +499,12 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   d.setDipoleFinalSweep(false);
   d.setIPSREnabled(false);
   d.setIPSRMaxIterations(4);
-  d.setEdgeWeight(DACPO_WEIGHT_VCR);
+  d.setEdgeWeight(Orientation::EdgeWeight::VCR);
   d.setSolverTimeLimit(2.5);
   d.setSeed(99);
   d.setNumberOfThreads(3);
   d.setDipoleNoiseBand(2.5);
-  d.setDisconnectedPolicy(DACPO_DISCONNECTED_BRIDGE);
+  d.setDisconnectedPolicy(Orientation::DisconnectedPolicy::Bridge);
   EXPECT_EQ(d.getNormalK(), 12u);
   EXPECT_EQ(d.getNumberOfBlocks(), 7u);
   EXPECT_EQ(d.getRingHops(), 2u);
@@ -512,12 +513,12 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_FALSE(d.getDipoleFinalSweep());
   EXPECT_FALSE(d.getIPSREnabled());
   EXPECT_EQ(d.getIPSRMaxIterations(), 4u);
-  EXPECT_EQ(d.getEdgeWeight(), DACPO_WEIGHT_VCR);
+  EXPECT_EQ(d.getEdgeWeight(), Orientation::EdgeWeight::VCR);
   EXPECT_EQ(d.getSolverTimeLimit(), 2.5);
   EXPECT_EQ(d.getSeed(), 99u);
   EXPECT_EQ(d.getNumberOfThreads(), 3u);
   EXPECT_EQ(d.getDipoleNoiseBand(), 2.5);
-  EXPECT_EQ(d.getDisconnectedPolicy(), DACPO_DISCONNECTED_BRIDGE);
+  EXPECT_EQ(d.getDisconnectedPolicy(), Orientation::DisconnectedPolicy::Bridge);
   const dacpo_params p = d.getParameters();
   EXPECT_EQ(p.k, 10u);
   EXPECT_EQ(p.estimate_normals, 1);
@@ -550,12 +551,12 @@ TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
   const Scene scene = makeScene(DACPO_SCENE_BOX_OPEN, 6000);
   pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
   skipIPSR(dacpo);
-  EXPECT_EQ(dacpo.getSignPolicy(), DACPO_SIGN_FREE_SPACE);
+  EXPECT_EQ(dacpo.getSignPolicy(), Orientation::SignPolicy::FreeSpace);
   dacpo.setInputCloud(scene.cloud);
   dacpo.setInputNormals(scene.scrambled);
   pcl::PointCloud<pcl::Normal> out;
   dacpo.compute(out);
-  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  ASSERT_EQ(dacpo.getLastStatus(), Orientation::Status::OK);
   EXPECT_GT(rightAsGiven(scene.gt, out), 99.0);
 
   // a sensor far out below the x = 0, y = 0 corner (the box is [0, 4] x [0, 3]
@@ -567,9 +568,9 @@ TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
   moved->sensor_origin_ = Eigen::Vector4f(-1000.0f, -1000.0f, -1000.0f, 1.0f);
   dacpo.setInputCloud(moved);
   dacpo.useSensorOriginAsViewPoint();
-  EXPECT_EQ(dacpo.getSignPolicy(), DACPO_SIGN_VIEWPOINT);
+  EXPECT_EQ(dacpo.getSignPolicy(), Orientation::SignPolicy::ViewPoint);
   dacpo.compute(out);
-  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK);
+  ASSERT_EQ(dacpo.getLastStatus(), Orientation::Status::OK);
   EXPECT_LT(rightAsGiven(scene.gt, out), 1.0);
   EXPECT_NEAR(dacpo.getStats().sign_facing, 29.5 / 47.0, 0.03);
   EXPECT_EQ(dacpo.getStats().sign_viewpoint[2], -1000.0);
@@ -584,7 +585,7 @@ TEST(DACPONormalOrientation, SignPolicyFacesFreeSpaceSensorOriginOrViewpoint)
   EXPECT_GT(dacpo.getStats().sign_facing, 0.99);
 
   // KEEP: the method's own sign, the same normals up to one flip
-  dacpo.setSignPolicy(DACPO_SIGN_KEEP);
+  dacpo.setSignPolicy(Orientation::SignPolicy::Keep);
   pcl::PointCloud<pcl::Normal> kept;
   dacpo.compute(kept);
   EXPECT_EQ(dacpo.getStats().sign_flipped, 0);
@@ -637,13 +638,13 @@ TEST(DACPONormalOrientation, OrganizedFrameFacesItsSensorOrigin)
   dacpo.useSensorOriginAsViewPoint();
   pcl::PointCloud<pcl::Normal> out;
   dacpo.compute(out);
-  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK) << dacpo.getLastError();
+  ASSERT_EQ(dacpo.getLastStatus(), Orientation::Status::OK) << dacpo.getLastError();
   ASSERT_EQ(out.size(), frame->size());
   EXPECT_EQ(out.width, static_cast<std::uint32_t>(W));
   EXPECT_GT(rightAsGiven(gt, out), 99.0);
   EXPECT_GT(dacpo.getStats().sign_facing, 0.99);
 
-  dacpo.setSignPolicy(DACPO_SIGN_FREE_SPACE);
+  dacpo.setSignPolicy(Orientation::SignPolicy::FreeSpace);
   dacpo.compute(out);
   EXPECT_GT(rightAsGiven(gt, out), 99.0);
 }
@@ -663,7 +664,7 @@ TEST(DACPONormalOrientation, KeptMeshAsPolygonMesh)
 
   dacpo.setKeepMesh(true);
   dacpo.compute(out);
-  ASSERT_EQ(dacpo.getLastStatus(), DACPO_OK) << dacpo.getLastError();
+  ASSERT_EQ(dacpo.getLastStatus(), Orientation::Status::OK) << dacpo.getLastError();
   ASSERT_TRUE(dacpo.getMesh(mesh));
   pcl::PointCloud<pcl::PointXYZ> v;
   pcl::fromPCLPointCloud2(mesh.cloud, v);

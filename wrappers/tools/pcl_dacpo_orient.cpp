@@ -405,7 +405,7 @@ compute(const pcl::PCLPointCloud2& input,
     std::fprintf(stderr, "\r%78s\r", "");
   if (normals_out.size() != n) {
     print_error("Error: orientation failed: %s: %s\n",
-                dacpo_status_string(dacpo.getLastStatus()),
+                dacpo.statusString(dacpo.getLastStatus()),
                 dacpo.getLastError().c_str());
     return false;
   }

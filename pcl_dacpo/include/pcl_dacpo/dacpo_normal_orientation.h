@@ -29,6 +29,44 @@
 
 namespace pcl {
 
+namespace dacpo {
+/* C++ names of the C core's enums (same values), shared by every
+ * DACPONormalOrientation<PointInT, PointOutT>. */
+/** \brief Outcome of compute() (the values of the C core's dacpo_status). */
+enum class Status : int {
+  OK = DACPO_OK,
+  InvalidArgument = DACPO_ERR_INVALID_ARGUMENT,
+  EmptyInput = DACPO_ERR_EMPTY_INPUT,
+  NonFiniteInput = DACPO_ERR_NONFINITE_INPUT,
+  TooFewPoints = DACPO_ERR_TOO_FEW_POINTS,
+  Disconnected = DACPO_ERR_DISCONNECTED,
+  NeighborSearch = DACPO_ERR_NEIGHBOR_SEARCH,
+  Solver = DACPO_ERR_SOLVER,
+  OutOfMemory = DACPO_ERR_OUT_OF_MEMORY,
+  Cancelled = DACPO_ERR_CANCELLED,
+  Internal = DACPO_ERR_INTERNAL
+};
+/** \brief Consistency measure of the block-graph edges (dacpo_edge_weight). */
+enum class EdgeWeight : int {
+  DipoleBoundary = DACPO_WEIGHT_DIPOLE_BOUNDARY,
+  VCR = DACPO_WEIGHT_VCR, ///< visible connected regions (paper, default)
+  Overlap = DACPO_WEIGHT_OVERLAP
+};
+/** \brief Which of the two consistent orientations is returned (dacpo_sign_policy). */
+enum class SignPolicy : int {
+  FreeSpace = DACPO_SIGN_FREE_SPACE, ///< face the free space seen from (default)
+  ViewPoint = DACPO_SIGN_VIEWPOINT,  ///< most normals face setViewPoint()
+  Keep = DACPO_SIGN_KEEP             ///< the method's arbitrary sign
+};
+/** \brief Disconnected k-NN graphs (dacpo_disconnected_policy). */
+enum class DisconnectedPolicy : int {
+  Separate = DACPO_DISCONNECTED_SEPARATE,  ///< relative sign undefined
+  Error = DACPO_DISCONNECTED_ERROR,        ///< fail with Status::Disconnected
+  Bridge = DACPO_DISCONNECTED_BRIDGE,      ///< join along the Euclidean MST
+  ViewPoint = DACPO_DISCONNECTED_VIEWPOINT ///< face the implied viewpoint (default)
+};
+} // namespace dacpo
+
 /**
  * \brief Orients point normals consistently over a whole scene with DACPO
  * ("A Divide-and-Conquer Approach for Global Orientation of Non-Watertight
@@ -60,7 +98,7 @@ namespace pcl {
  *
  * Several connected components of the k-NN graph are oriented separately, then
  * each takes the sign under which its points face the viewpoint implied by the
- * largest component (DACPO_DISCONNECTED_VIEWPOINT, the default);
+ * largest component (DisconnectedPolicy::ViewPoint, the default);
  * setDisconnectedPolicy() chooses otherwise. A PCL_WARN reports the count and how
  * many parts were related; getComponentLabels() tells them apart.
  *
@@ -81,6 +119,18 @@ namespace pcl {
 template <typename PointInT, typename PointOutT>
 class DACPONormalOrientation : public Feature<PointInT, PointOutT> {
 public:
+  using Status = dacpo::Status;
+  using EdgeWeight = dacpo::EdgeWeight;
+  using SignPolicy = dacpo::SignPolicy;
+  using DisconnectedPolicy = dacpo::DisconnectedPolicy;
+
+  /** \brief Fixed English text of a status. */
+  static const char*
+  statusString(Status status)
+  {
+    return dacpo_status_string(static_cast<dacpo_status>(status));
+  }
+
   using Ptr = shared_ptr<DACPONormalOrientation<PointInT, PointOutT>>;
   using ConstPtr = shared_ptr<const DACPONormalOrientation<PointInT, PointOutT>>;
   using PointCloudIn = typename Feature<PointInT, PointOutT>::PointCloudIn;
@@ -262,17 +312,17 @@ public:
   }
 
   /** \brief Consistency measure of the block-graph edges (default
-   *  DACPO_WEIGHT_VCR, the paper's visible connected regions). */
+   *  EdgeWeight::VCR, the paper's visible connected regions). */
   void
-  setEdgeWeight(dacpo_edge_weight weight)
+  setEdgeWeight(EdgeWeight weight)
   {
-    params_.edge_weight = weight;
+    params_.edge_weight = static_cast<dacpo_edge_weight>(weight);
   }
   /** \brief See setEdgeWeight(). */
-  dacpo_edge_weight
+  EdgeWeight
   getEdgeWeight() const
   {
-    return params_.edge_weight;
+    return static_cast<EdgeWeight>(params_.edge_weight);
   }
 
   /**
@@ -336,7 +386,7 @@ public:
 
   /** \brief Block-graph edges with less than this fraction of the median
    *  edge's evidence leave the relative sign of the block groups they join to
-   *  the viewpoint vote (DACPO_DISCONNECTED_VIEWPOINT only; 0 = only
+   *  the viewpoint vote (DisconnectedPolicy::ViewPoint only; 0 = only
    *  disconnected parts; default 1: every edge below the median). A part
    *  follows the vote only when its margin is >= 0.3. */
   void
@@ -352,25 +402,25 @@ public:
   }
 
   /** \brief Which of the two consistent orientations to return (default
-   *  DACPO_SIGN_FREE_SPACE: normals face the free space the scan was seen from,
+   *  SignPolicy::FreeSpace: normals face the free space the scan was seen from,
    *  no sensor position needed; closed objects get outward normals). */
   void
-  setSignPolicy(dacpo_sign_policy policy)
+  setSignPolicy(SignPolicy policy)
   {
-    params_.sign_policy = policy;
-    if (policy != DACPO_SIGN_VIEWPOINT)
+    params_.sign_policy = static_cast<dacpo_sign_policy>(policy);
+    if (policy != SignPolicy::ViewPoint)
       use_sensor_origin_ = false;
   }
   /** \brief See setSignPolicy(). */
-  dacpo_sign_policy
+  SignPolicy
   getSignPolicy() const
   {
-    return params_.sign_policy;
+    return static_cast<SignPolicy>(params_.sign_policy);
   }
 
   /** \brief Make most normals face (vpx, vpy, vpz), as PCL's NormalEstimation
    *  does, but with one sign for the whole cloud so consistency is kept
-   *  (sets DACPO_SIGN_VIEWPOINT). */
+   *  (sets SignPolicy::ViewPoint). */
   void
   setViewPoint(float vpx, float vpy, float vpz)
   {
@@ -389,7 +439,7 @@ public:
     vpz = static_cast<float>(params_.viewpoint[2]);
   }
   /** \brief Face the input cloud's sensor_origin_ (read at compute() time;
-   *  sets DACPO_SIGN_VIEWPOINT). */
+   *  sets SignPolicy::ViewPoint). */
   void
   useSensorOriginAsViewPoint()
   {
@@ -398,17 +448,17 @@ public:
   }
 
   /** \brief What to do with a disconnected k-NN graph (default: relate the parts
-   *  by the viewpoint the largest one implies, DACPO_DISCONNECTED_VIEWPOINT). */
+   *  by the viewpoint the largest one implies, DisconnectedPolicy::ViewPoint). */
   void
-  setDisconnectedPolicy(dacpo_disconnected_policy policy)
+  setDisconnectedPolicy(DisconnectedPolicy policy)
   {
-    params_.disconnected = policy;
+    params_.disconnected = static_cast<dacpo_disconnected_policy>(policy);
   }
   /** \brief See setDisconnectedPolicy(). */
-  dacpo_disconnected_policy
+  DisconnectedPolicy
   getDisconnectedPolicy() const
   {
-    return params_.disconnected;
+    return static_cast<DisconnectedPolicy>(params_.disconnected);
   }
 
   /** \brief VCR image side in pixels (default 400, as in the paper). */
@@ -492,6 +542,22 @@ public:
     return params_.dipole_noise_band;
   }
 
+  /** \brief Thin two-sided parts (default 3, 0 = off): neighbours with parallel axes
+   * that lie off each other's tangent plane by more than this many times the local
+   * noise (and 0.5 to 2 local spacings), beneath one another, are taken as the two
+   * faces of one thin part and made to face opposite ways. */
+  void
+  setDipoleTwoSheet(double factor)
+  {
+    params_.dipole_two_sheet = factor;
+  }
+  /** \brief See setDipoleTwoSheet(). */
+  double
+  getDipoleTwoSheet() const
+  {
+    return params_.dipole_two_sheet;
+  }
+
   /**
    * \brief Set every core parameter at once. params.k replaces setKSearch();
    * params.estimate_normals is ignored (decided by setInputNormals()).
@@ -520,11 +586,11 @@ public:
     progress_ = callback;
   }
 
-  /** \brief Status of the last compute() (::DACPO_OK on success). */
-  dacpo_status
+  /** \brief Status of the last compute() (Status::OK on success). */
+  Status
   getLastStatus() const
   {
-    return last_status_;
+    return static_cast<Status>(last_status_);
   }
   /** \brief Message of the last failure, "" after a success. */
   const std::string&
