@@ -16,7 +16,7 @@ typedef struct dacpo_ipsr_params {
   double point_weight;   /* screening alpha, PSR convention (16) */
   double cell_per_spacing; /* cell size / median spacing (1.0) */
   size_t max_resolution;   /* cap on cells per axis (128) */
-  /* Added by the stage-3 implementation (defaults from dacpo_ipsr_params_default;
+  /* Grid, solver and trimming details (defaults from dacpo_ipsr_params_default;
    * 0 selects the default for the first four): */
   double padding;   /* band 0 only: box grows by this share of its longest side (0.1) */
   size_t max_cells; /* cap on grid cells, bounds memory (1.5e6: <= 41 MB) */
@@ -36,7 +36,7 @@ typedef struct dacpo_ipsr_stats {
   size_t resolution; /* cells per axis used */
   double seconds;
   size_t peak_bytes;
-  /* Added by the stage-3 implementation: */
+  /* Grid and timing details: */
   double spacing;         /* sample spacing (sqrt of the median area per sample) */
   double cell;            /* grid cell edge */
   size_t dims[3];         /* grid cells per axis */

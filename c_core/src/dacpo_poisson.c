@@ -1168,12 +1168,6 @@ dacpo_poisson_domain_cells(const dacpo_poisson* ps)
 }
 
 double
-dacpo_poisson_iso_value(const dacpo_poisson* ps)
-{
-  return ps ? ps->iso : 0.0;
-}
-
-double
 dacpo_poisson_evaluate(const dacpo_poisson* ps, const double p[3])
 {
   if (!ps || !p)

@@ -84,10 +84,6 @@ dacpo_poisson_domain(const dacpo_poisson* ps);
 size_t
 dacpo_poisson_domain_cells(const dacpo_poisson* ps);
 
-/* Iso-value of the last solve (area-weighted mean of chi at the samples). */
-double
-dacpo_poisson_iso_value(const dacpo_poisson* ps);
-
 /* chi at any point (trilinear between the domain's cell centres, clamped to
  * the box; the iso-value where no domain cell is near). */
 double

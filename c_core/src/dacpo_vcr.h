@@ -11,11 +11,13 @@ typedef struct dacpo_vcr_params {
   size_t num_views;    /* 12 (dodecahedron face centres) */
   int perspective;     /* 0 orthographic, 1 perspective */
   int boundary_factor; /* 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 */
-  /* Added by stage 4 (appended; defaults from dacpo_vcr_params_default): */
-  size_t gap_fill;       /* 2: empty pixels within this many 4-steps of a drawn pixel
-                            take the nearest neighbour's depth and triangle, so a seam
-                            of up to 2*gap_fill pixels between the two meshes still
-                            joins them; 0 = off */
+  /* Seam closing (defaults from dacpo_vcr_params_default): */
+  size_t gap_fill; /* 2: empty pixels within this many 4-steps of a drawn pixel
+                      take the nearest neighbour's depth and triangle, so a seam
+                      of up to 2*gap_fill pixels between the two meshes still
+                      joins them; 0 = off */
+  /* Paper variants kept for comparison (measured no better; only tests set
+   * them): */
   int drop_partial;      /* 0; 1: remove the pixels of triangles that are only partly
                             visible (paper Fig. "VCR" (b, e)) */
   int eta_all;           /* 0: eta = largest depth span of the triangles that own at
@@ -49,8 +51,6 @@ dacpo_vcr_edge(const dacpo_mesh* a,
                double* alpha_bar,
                dacpo_vcr_trace* trace,
                dacpo_err* err);
-
-/* ---- additions (stage 4) ------------------------------------------------ */
 
 /* Unit view directions used for num_views views (the camera looks along them):
  * num_views <= 12: the first num_views of the 12 icosahedron vertex directions
