@@ -323,29 +323,29 @@ orthonormal_basis(const double d[3], double u[3], double v[3])
   v[2] = d[0] * u[1] - d[1] * u[0];
 }
 
-/* One view: steps 1-5 of the file comment. Returns 0 contributions when the
- * projection is degenerate. images: NULL or N*N bytes. */
-static void
-run_view(vcr_work* w,
-         const dacpo_vcr_params* prm,
-         const double centre[3],
-         double radius,
-         const double d[3],
-         view_result* res,
-         uint8_t* image)
-{
-  memset(res, 0, sizeof(*res));
-  const size_t N = w->N;
-  const int persp = prm->perspective != 0;
-  double u[3], v[3];
-  orthonormal_basis(d, u, v);
-  double eye[3] = {0, 0, 0};
-  double dist = 2.0 * radius;
-  if (persp)
-    for (int k = 0; k < 3; ++k)
-      eye[k] = centre[k] - dist * d[k];
-  const double* origin = persp ? eye : centre;
+/* The camera of one view: looks along d; perspective from eye. */
+typedef struct view_camera {
+  const double* d;
+  double u[3], v[3], eye[3];
+  double dist;
+  int persp;
+} view_camera;
 
+/* Step 1: project the used vertices, fit the image to their 2D box and choose
+ * the seam-closing radius. Returns 0 when the projection is degenerate. */
+static int
+view_project(vcr_work* w,
+             const dacpo_vcr_params* prm,
+             const double centre[3],
+             double radius,
+             const view_camera* cam,
+             size_t* gap_out)
+{
+  const size_t N = w->N;
+  const int persp = cam->persp;
+  const double *u = cam->u, *v = cam->v, *d = cam->d;
+  const double dist = cam->dist;
+  const double* origin = persp ? cam->eye : centre;
   /* 1. project the used vertices and fit their 2D bounding box */
   double minx = INFINITY, maxx = -INFINITY, miny = INFINITY, maxy = -INFINITY;
   for (size_t i = 0; i < w->nv; ++i) {
@@ -373,7 +373,7 @@ run_view(vcr_work* w,
   double ext = fmax(maxx - minx, maxy - miny);
   double rel = persp ? ext : ext / radius; /* perspective coords are already angles */
   if (!(rel > 1e-9) || !isfinite(ext))
-    return;
+    return 0;
   double margin = 1.0 + (double)prm->gap_fill;
   double scale = ((double)N - 2.0 * margin) / ext;
   /* seam closing radius: gap_fill pixels, or gap_fill_edges median edges */
@@ -386,7 +386,7 @@ run_view(vcr_work* w,
     if (want > (double)gap)
       gap = (size_t)want;
   }
-  res->gap = gap;
+  *gap_out = gap;
   double cx = 0.5 * (minx + maxx), cy = 0.5 * (miny + maxy);
   for (size_t i = 0; i < w->nv; ++i) {
     if (!w->used[i])
@@ -398,6 +398,17 @@ run_view(vcr_work* w,
       w->scr[3 * i + 2] = -1.0 / w->scr[3 * i + 2];
   }
 
+  return 1;
+}
+
+/* Step 2: facing of every triangle and z-buffer rasterization (a first, then
+ * b: exact depth ties keep a). Returns 0 when nothing was drawn. */
+static int
+view_rasterize(vcr_work* w, const view_camera* cam)
+{
+  const size_t N = w->N;
+  const int persp = cam->persp;
+  const double *d = cam->d, *eye = cam->eye;
   /* 2. facing and rasterization (a first, then b: exact depth ties keep a) */
   for (size_t t = 0; t < w->nt; ++t) {
     const double* n = &w->tri_normal[3 * t];
@@ -416,7 +427,7 @@ run_view(vcr_work* w,
   }
   dacpo_raster* R = &w->r;
   if (R->x0 > R->x1)
-    return;
+    return 0;
   /* cls: 1 = drawn, 0 = empty (for the seam closing; pass 4 overwrites it) */
   uint8_t* cls = w->cls;
   for (size_t y = R->y0; y <= R->y1; ++y)
@@ -431,6 +442,17 @@ run_view(vcr_work* w,
       }
     }
 
+  return 1;
+}
+
+/* Step 3: eta, the largest depth span of the retained triangles (optionally
+ * removing the pixels of partly visible ones first). */
+static double
+view_eta(vcr_work* w, const dacpo_vcr_params* prm)
+{
+  const size_t N = w->N;
+  dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
   /* 3. eta over the retained triangles; optional removal of partly visible ones */
   double eta = 0.0;
   for (size_t t = 0; t < w->nt; ++t) {
@@ -459,12 +481,18 @@ run_view(vcr_work* w,
         }
       }
   }
-  /* float depths: allow a few ulps of the scene size on top of eta */
-  const double thr = eta + 1e-5 * radius;
+  return eta;
+}
 
-  /* seam closing: each round, empty pixels next to drawn ones copy the nearest
-   * of them. cls marks drawn pixels (1) and the round + 1 a pixel was filled
-   * in; pixels outside the rectangle are empty and their cls is stale. */
+/* Seam closing: each round, empty pixels next to drawn ones copy the nearest
+ * of them. cls marks drawn pixels (1) and the round + 1 a pixel was filled
+ * in; pixels outside the rectangle are empty and their cls is stale. */
+static void
+view_close_seams(vcr_work* w, size_t gap)
+{
+  dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  const size_t N = w->N;
   size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
   if (gap > 0) {
     size_t g = gap;
@@ -545,7 +573,17 @@ run_view(vcr_work* w,
       ncur = nnext;
     }
   }
+}
 
+/* Step 4: atoms - pixels of the same mesh, depth-continuous (within thr), of
+ * the same facing - and the cross pairs between the two meshes. */
+static void
+view_atoms(vcr_work* w, double thr, view_result* res)
+{
+  const size_t N = w->N;
+  dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  const size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
   /* 4. atoms: same mesh, depth-continuous, same facing; mark cross pairs.
    * cls = 0 empty, else 1 + 2 * mesh + back (one byte read per neighbour). */
   const int32_t nat = (int32_t)w->na_t;
@@ -594,9 +632,18 @@ run_view(vcr_work* w,
         }
       }
     }
+}
 
-  /* compact atom ids (roots precede their members in scan order) and the
-   * cross-pair unions of both labellings */
+/* Compact atom ids (roots precede their members in scan order), atom sums and
+ * the cross-pair unions of both labellings. Returns the number of atoms. */
+static int32_t
+view_compact_atoms(vcr_work* w, uint8_t* image)
+{
+  const size_t N = w->N;
+  dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  int32_t* parent = w->parent;
+  const size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
   int32_t K = 0;
   for (size_t y = y0; y <= y1; ++y)
     for (size_t x = x0; x <= x1; ++x) {
@@ -635,6 +682,15 @@ run_view(vcr_work* w,
       w->flags[p] = 0;
     }
 
+  return K;
+}
+
+/* Step 5: per labelling (as given / b inverted), the sub-regions holding both
+ * meshes and their score I = C_B * C1 * C2 (Eq. 6). */
+static void
+view_regions(vcr_work* w, const dacpo_vcr_params* prm, int32_t K, view_result* res)
+{
+  const size_t N = w->N;
   /* 5. per labelling: sub-region sums, I = C_B * C1 * C2 (Eq. 6) */
   const double n1 = (double)N, n2 = (double)N * (double)N;
   for (int lab = 0; lab < 2; ++lab) {
@@ -670,7 +726,139 @@ run_view(vcr_work* w,
       res->regions[1] = regions;
     }
   }
+}
+
+/* One view: steps 1-5 of the file comment. Returns 0 contributions when the
+ * projection is degenerate. images: NULL or N*N bytes. */
+static void
+run_view(vcr_work* w,
+         const dacpo_vcr_params* prm,
+         const double centre[3],
+         double radius,
+         const double d[3],
+         view_result* res,
+         uint8_t* image)
+{
+  memset(res, 0, sizeof(*res));
+  view_camera cam;
+  cam.d = d;
+  cam.persp = prm->perspective != 0;
+  cam.dist = 2.0 * radius;
+  orthonormal_basis(d, cam.u, cam.v);
+  for (int k = 0; k < 3; ++k)
+    cam.eye[k] = cam.persp ? centre[k] - cam.dist * d[k] : 0.0;
+  size_t gap = 0;
+  if (!view_project(w, prm, centre, radius, &cam, &gap))
+    return;
+  res->gap = gap;
+  if (!view_rasterize(w, &cam))
+    return;
+  const double eta = view_eta(w, prm);
+  view_close_seams(w, gap);
+  /* float depths: allow a few ulps of the scene size on top of eta */
+  view_atoms(w, eta + 1e-5 * radius, res);
+  const int32_t K = view_compact_atoms(w, image);
+  view_regions(w, prm, K, res);
   res->eta = eta;
+}
+
+/* The parameters dacpo_vcr_edge accepts. */
+static dacpo_status
+vcr_check_params(const dacpo_vcr_params* p, dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              p->image_size >= 8 && p->image_size <= VCR_MAX_IMAGE,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: image_size %zu outside [8, %d]",
+              p->image_size,
+              VCR_MAX_IMAGE);
+  DACPO_CHECK(err,
+              p->num_views >= 1 && p->num_views <= VCR_MAX_VIEWS,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: num_views %zu outside [1, %d]",
+              p->num_views,
+              VCR_MAX_VIEWS);
+  DACPO_CHECK(err,
+              p->perspective == 0 || p->perspective == 1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: perspective must be 0 or 1 (got %d)",
+              p->perspective);
+  DACPO_CHECK(err,
+              p->boundary_factor == 0 || p->boundary_factor == 1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: boundary_factor must be 0 or 1 (got %d)",
+              p->boundary_factor);
+  DACPO_CHECK(
+      err,
+      p->gap_fill <= 32 && 4 * (p->gap_fill + 1) < p->image_size,
+      DACPO_ERR_INVALID_ARGUMENT,
+      "vcr: gap_fill %zu too large for image_size %zu (max min(32, size/4 - 1))",
+      p->gap_fill,
+      p->image_size);
+  DACPO_CHECK(err,
+              p->gap_fill_edges >= 0.0 && p->gap_fill_edges <= 100.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "vcr: gap_fill_edges %g outside [0, 100]",
+              p->gap_fill_edges);
+  return DACPO_OK;
+}
+
+/* Marks the used vertices, computes face normals and centres and the median
+ * edge; centre and radius of the union bounding box. */
+static void
+vcr_prepare(vcr_work* w, double centre[3], double* radius_out)
+{
+  /* used vertices, union bounding box, face normals and centres */
+  double lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t t = 0; t < w->nt; ++t) {
+    const double* p[3];
+    for (int k = 0; k < 3; ++k) {
+      size_t gv = corner(w, t, k);
+      w->used[gv] = 1;
+      p[k] = vertex_of(w, gv);
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = p[k][c] < lo[c] ? p[k][c] : lo[c];
+        hi[c] = p[k][c] > hi[c] ? p[k][c] : hi[c];
+      }
+    }
+    double e1[3], e2[3];
+    for (int c = 0; c < 3; ++c) {
+      e1[c] = p[1][c] - p[0][c];
+      e2[c] = p[2][c] - p[0][c];
+      w->tri_centre[3 * t + (size_t)c] = (p[0][c] + p[1][c] + p[2][c]) / 3.0;
+    }
+    w->tri_normal[3 * t + 0] = e1[1] * e2[2] - e1[2] * e2[1];
+    w->tri_normal[3 * t + 1] = e1[2] * e2[0] - e1[0] * e2[2];
+    w->tri_normal[3 * t + 2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  w->edge_len = median_edge_length(w);
+  double radius = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    centre[c] = 0.5 * (lo[c] + hi[c]);
+    radius += 0.25 * (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  }
+  radius = sqrt(radius);
+
+  *radius_out = radius;
+}
+
+/* What one view contributed, for a dacpo_vcr_trace. */
+static void
+view_stats(const view_result* res, const double dir[3], dacpo_vcr_view_stats* vs)
+{
+  for (int c = 0; c < 3; ++c)
+    vs->direction[c] = dir[c];
+  vs->eta = res->eta;
+  vs->pixels_a = res->pix[0];
+  vs->pixels_b = res->pix[1];
+  vs->cross_same = res->cross_same;
+  vs->cross_diff = res->cross_diff;
+  vs->regions = res->regions[0];
+  vs->regions_bar = res->regions[1];
+  vs->alpha = res->alpha;
+  vs->alpha_bar = res->alpha_bar;
+  vs->gap_pixels = res->gap;
 }
 
 dacpo_status
@@ -695,40 +883,7 @@ dacpo_vcr_edge(const dacpo_mesh* a,
     dacpo_vcr_params_default(&prm);
   *alpha = 0.0;
   *alpha_bar = 0.0;
-  DACPO_CHECK(err,
-              prm.image_size >= 8 && prm.image_size <= VCR_MAX_IMAGE,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: image_size %zu outside [8, %d]",
-              prm.image_size,
-              VCR_MAX_IMAGE);
-  DACPO_CHECK(err,
-              prm.num_views >= 1 && prm.num_views <= VCR_MAX_VIEWS,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: num_views %zu outside [1, %d]",
-              prm.num_views,
-              VCR_MAX_VIEWS);
-  DACPO_CHECK(err,
-              prm.perspective == 0 || prm.perspective == 1,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: perspective must be 0 or 1 (got %d)",
-              prm.perspective);
-  DACPO_CHECK(err,
-              prm.boundary_factor == 0 || prm.boundary_factor == 1,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: boundary_factor must be 0 or 1 (got %d)",
-              prm.boundary_factor);
-  DACPO_CHECK(
-      err,
-      prm.gap_fill <= 32 && 4 * (prm.gap_fill + 1) < prm.image_size,
-      DACPO_ERR_INVALID_ARGUMENT,
-      "vcr: gap_fill %zu too large for image_size %zu (max min(32, size/4 - 1))",
-      prm.gap_fill,
-      prm.image_size);
-  DACPO_CHECK(err,
-              prm.gap_fill_edges >= 0.0 && prm.gap_fill_edges <= 100.0,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "vcr: gap_fill_edges %g outside [0, 100]",
-              prm.gap_fill_edges);
+  DACPO_TRY(vcr_check_params(&prm, err));
   DACPO_TRY(check_mesh(a, "a", err));
   DACPO_TRY(check_mesh(b, "b", err));
   if (views != NULL)
@@ -756,37 +911,8 @@ dacpo_vcr_edge(const dacpo_mesh* a,
   }
   dacpo_vcr_view_directions(prm.num_views, dirs);
 
-  /* used vertices, union bounding box, face normals and centres */
-  double lo[3] = {INFINITY, INFINITY, INFINITY},
-         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (size_t t = 0; t < w.nt; ++t) {
-    const double* p[3];
-    for (int k = 0; k < 3; ++k) {
-      size_t gv = corner(&w, t, k);
-      w.used[gv] = 1;
-      p[k] = vertex_of(&w, gv);
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = p[k][c] < lo[c] ? p[k][c] : lo[c];
-        hi[c] = p[k][c] > hi[c] ? p[k][c] : hi[c];
-      }
-    }
-    double e1[3], e2[3];
-    for (int c = 0; c < 3; ++c) {
-      e1[c] = p[1][c] - p[0][c];
-      e2[c] = p[2][c] - p[0][c];
-      w.tri_centre[3 * t + (size_t)c] = (p[0][c] + p[1][c] + p[2][c]) / 3.0;
-    }
-    w.tri_normal[3 * t + 0] = e1[1] * e2[2] - e1[2] * e2[1];
-    w.tri_normal[3 * t + 1] = e1[2] * e2[0] - e1[0] * e2[2];
-    w.tri_normal[3 * t + 2] = e1[0] * e2[1] - e1[1] * e2[0];
-  }
-  w.edge_len = median_edge_length(&w);
-  double centre[3], radius = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    centre[c] = 0.5 * (lo[c] + hi[c]);
-    radius += 0.25 * (hi[c] - lo[c]) * (hi[c] - lo[c]);
-  }
-  radius = sqrt(radius);
+  double centre[3], radius;
+  vcr_prepare(&w, centre, &radius);
 
   double sum_a = 0.0, sum_b = 0.0;
   if (radius > 0.0 && isfinite(radius)) {
@@ -803,21 +929,8 @@ dacpo_vcr_edge(const dacpo_mesh* a,
                images ? images + j * npix : NULL);
       sum_a += res.alpha;
       sum_b += res.alpha_bar;
-      if (views != NULL) {
-        dacpo_vcr_view_stats* vs = &views[j];
-        for (int c = 0; c < 3; ++c)
-          vs->direction[c] = dirs[3 * j + (size_t)c];
-        vs->eta = res.eta;
-        vs->pixels_a = res.pix[0];
-        vs->pixels_b = res.pix[1];
-        vs->cross_same = res.cross_same;
-        vs->cross_diff = res.cross_diff;
-        vs->regions = res.regions[0];
-        vs->regions_bar = res.regions[1];
-        vs->alpha = res.alpha;
-        vs->alpha_bar = res.alpha_bar;
-        vs->gap_pixels = res.gap;
-      }
+      if (views != NULL)
+        view_stats(&res, &dirs[3 * j], &views[j]);
     }
   }
   free(dirs);
