@@ -575,24 +575,61 @@ dipole_confidence(
   }
 }
 
-dacpo_status
-dacpo_dipole_orient_confidence(const double* xyz,
-                               const double* nrm,
-                               size_t n,
-                               const dacpo_dipole_params* params,
-                               int8_t* sign_out,
-                               float* confidence,
-                               dacpo_err* err)
+/* One restart (paper Eq. 4 greedy + our vote and sweeps): M randomized orders,
+ * aligned and majority-voted, then Gauss-Seidel sweeps in order 0's BFS order
+ * until no point changes. Writes the signs to cand; returns the block energy
+ * sum_i s_i sum_t s_j e_ji (computed only when `score`). */
+static double
+dipole_restart(dipole_work* wk,
+               size_t n,
+               size_t K,
+               const dacpo_dipole_params* params,
+               size_t r,
+               int8_t* cand,
+               int score)
 {
-  DACPO_CHECK(
-      err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
-  if (n == 0)
-    return DACPO_OK;
-  DACPO_CHECK(err,
-              xyz && nrm && sign_out,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "dipole: NULL array for %zu points",
-              n);
+  const size_t M = params->orders;
+  for (size_t m = 0; m < M; ++m) {
+    dacpo_rng rng;
+    dacpo_rng_seed(&rng, params->seed + 7919u * r, params->stream * 1000003u + m);
+    dipole_one_order(wk, n, K, &rng, wk->sign + m * n, m == 0 ? wk->order0 : NULL);
+  }
+  /* Align, then majority vote; a tie keeps order 0's sign. */
+  const unsigned flip = dipole_align(wk->sign, n, M);
+  for (size_t i = 0; i < n; ++i) {
+    int votes = 0;
+    for (size_t m = 0; m < M; ++m)
+      votes += ((flip >> m) & 1u) ? -wk->sign[m * n + i] : wk->sign[m * n + i];
+    cand[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk->sign[i];
+  }
+  /* Gauss-Seidel sweeps in order 0's BFS order: every point now sees all K
+   * neighbours placed; an exact tie keeps the voted sign. Repeated (up to
+   * `sweeps` times) until no point changes: each change raises the energy. */
+  for (int sw = 0; sw < params->final_sweep; ++sw) {
+    size_t changed = 0;
+    for (size_t o = 0; o < n; ++o) {
+      const size_t i = (size_t)wk->order0[o];
+      const double sum = dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand);
+      const int8_t v = sum > 0.0 ? 1 : sum < 0.0 ? -1 : cand[i];
+      changed += v != cand[i];
+      cand[i] = v;
+    }
+    if (changed == 0)
+      break;
+  }
+  if (!score)
+    return 0.0;
+  double energy = 0.0;
+  for (size_t i = 0; i < n; ++i)
+    energy +=
+        (double)cand[i] * dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand);
+  return energy;
+}
+
+/* The arguments dacpo_dipole_orient_confidence accepts (n >= 1). */
+static dacpo_status
+dipole_check(size_t n, const dacpo_dipole_params* params, dacpo_err* err)
+{
   DACPO_CHECK(err,
               n <= (size_t)INT32_MAX,
               DACPO_ERR_INVALID_ARGUMENT,
@@ -613,6 +650,28 @@ dacpo_dipole_orient_confidence(const double* xyz,
               DACPO_ERR_INVALID_ARGUMENT,
               "dipole: restarts must be <= 64 (got %zu)",
               params->restarts);
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_dipole_orient_confidence(const double* xyz,
+                               const double* nrm,
+                               size_t n,
+                               const dacpo_dipole_params* params,
+                               int8_t* sign_out,
+                               float* confidence,
+                               dacpo_err* err)
+{
+  DACPO_CHECK(
+      err, params != NULL, DACPO_ERR_INVALID_ARGUMENT, "dipole: params is NULL");
+  if (n == 0)
+    return DACPO_OK;
+  DACPO_CHECK(err,
+              xyz && nrm && sign_out,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dipole: NULL array for %zu points",
+              n);
+  DACPO_TRY(dipole_check(n, params, err));
   if (n == 1) {
     sign_out[0] = 1;
     if (confidence)
@@ -654,40 +713,9 @@ dacpo_dipole_orient_confidence(const double* xyz,
   size_t best = 0;
   for (size_t r = 0; r < R; ++r) {
     int8_t* cand = wk.cand + r * n;
-    for (size_t m = 0; m < M; ++m) {
-      dacpo_rng rng;
-      dacpo_rng_seed(&rng, params->seed + 7919u * r, params->stream * 1000003u + m);
-      dipole_one_order(&wk, n, K, &rng, wk.sign + m * n, m == 0 ? wk.order0 : NULL);
-    }
-    /* Align, then majority vote; a tie keeps order 0's sign. */
-    const unsigned flip = dipole_align(wk.sign, n, M);
-    for (size_t i = 0; i < n; ++i) {
-      int votes = 0;
-      for (size_t m = 0; m < M; ++m)
-        votes += ((flip >> m) & 1u) ? -wk.sign[m * n + i] : wk.sign[m * n + i];
-      cand[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk.sign[i];
-    }
-    /* Gauss-Seidel sweeps in order 0's BFS order: every point now sees all K
-     * neighbours placed; an exact tie keeps the voted sign. Repeated (up to
-     * `sweeps` times) until no point changes: each change raises the energy. */
-    for (int sw = 0; sw < params->final_sweep; ++sw) {
-      size_t changed = 0;
-      for (size_t o = 0; o < n; ++o) {
-        const size_t i = (size_t)wk.order0[o];
-        const double sum = dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
-        const int8_t v = sum > 0.0 ? 1 : sum < 0.0 ? -1 : cand[i];
-        changed += v != cand[i];
-        cand[i] = v;
-      }
-      if (changed == 0)
-        break;
-    }
+    const double energy = dipole_restart(&wk, n, K, params, r, cand, R > 1);
     if (R == 1)
       break;
-    double energy = 0.0;
-    for (size_t i = 0; i < n; ++i)
-      energy +=
-          (double)cand[i] * dipole_field_sum(wk.nb + i * K, wk.w + i * K, K, cand);
     if (energy > best_energy) {
       best_energy = energy;
       best = r;
