@@ -451,22 +451,15 @@ check_params(const dacpo_ipsr_params* p, dacpo_err* err)
   return DACPO_OK;
 }
 
-dacpo_status
-dacpo_ipsr_block(const double* xyz,
-                 double* nrm,
-                 size_t n,
-                 size_t n_own,
-                 const dacpo_ipsr_params* params,
-                 dacpo_mesh* mesh_out,
-                 dacpo_ipsr_stats* stats,
-                 dacpo_err* err)
+/* The arguments dacpo_ipsr_block accepts. */
+static dacpo_status
+ipsr_check_args(const double* xyz,
+                const double* nrm,
+                size_t n,
+                size_t n_own,
+                const dacpo_ipsr_params* params,
+                dacpo_err* err)
 {
-  const double t_start = dacpo_now();
-  dacpo_ipsr_stats st_local;
-  dacpo_ipsr_stats* st = stats ? stats : &st_local;
-  memset(st, 0, sizeof(*st));
-  if (mesh_out)
-    memset(mesh_out, 0, sizeof(*mesh_out));
   DACPO_CHECK(err, params, DACPO_ERR_INVALID_ARGUMENT, "ipsr: params is NULL");
   DACPO_CHECK(err,
               n == 0 || (xyz && nrm),
@@ -486,6 +479,103 @@ dacpo_ipsr_block(const double* xyz,
                 DACPO_ERR_NONFINITE_INPUT,
                 "ipsr: sample %zu has a non-finite coordinate or normal",
                 i / 3);
+  return DACPO_OK;
+}
+
+/* The block's Poisson system (paper §4.3: Neumann screened Poisson on the
+ * block's box) and marching-cubes extractor; grid figures into st. */
+static dacpo_status
+ipsr_setup(ipsr_work* w,
+           const double* xyz,
+           size_t n,
+           double spacing,
+           const dacpo_ipsr_params* params,
+           dacpo_ipsr_stats* st,
+           dacpo_err* err)
+{
+  dacpo_poisson_params pp;
+  dacpo_poisson_params_default(&pp);
+  pp.cell_per_spacing = params->cell_per_spacing;
+  pp.max_resolution = params->max_resolution;
+  pp.point_weight = params->point_weight;
+  if (params->padding > 0.0)
+    pp.padding = params->padding;
+  if (params->max_cells > 0)
+    pp.max_cells = params->max_cells;
+  if (params->tolerance > 0.0)
+    pp.tolerance = params->tolerance;
+  if (params->max_cg_iterations > 0)
+    pp.max_cg_iterations = params->max_cg_iterations;
+  pp.band = params->band;
+  DACPO_TRY(dacpo_poisson_create(xyz, w->area, n, spacing, &pp, &w->ps, err));
+  DACPO_TRY(dacpo_mcubes_create(&w->mc, err));
+  const dacpo_grid* grid = dacpo_poisson_grid(w->ps);
+  st->resolution = grid->dims[0];
+  for (int a = 1; a < 3; ++a)
+    if (grid->dims[a] > st->resolution)
+      st->resolution = grid->dims[a];
+  st->spacing = spacing;
+  st->cell = grid->cell;
+  for (int a = 0; a < 3; ++a)
+    st->dims[a] = grid->dims[a];
+  st->domain_cells = dacpo_poisson_domain_cells(w->ps);
+  return DACPO_OK;
+}
+
+/* Every kept face sends its area-weighted normal to its k nearest samples;
+ * each sample's new normal is the normalized sum (one that received nothing
+ * keeps its normal). change[s] = |n_new - n_old|. */
+static void
+ipsr_vote(
+    ipsr_work* w, const dacpo_mesh* mesh, size_t k, double* nrm, double* old, size_t n)
+{
+  memset(w->acc, 0, 3 * n * sizeof(double));
+  for (size_t f = 0; f < mesh->num_triangles; ++f) {
+    if (w->removed[f])
+      continue;
+    const double* nf = w->fnrm + 3 * f;
+    const int32_t* nb = w->fknn + k * f;
+    for (size_t j = 0; j < k; ++j) {
+      if (nb[j] < 0)
+        break;
+      double* acc = w->acc + 3 * (size_t)nb[j];
+      acc[0] += nf[0];
+      acc[1] += nf[1];
+      acc[2] += nf[2];
+    }
+  }
+  memcpy(old, nrm, 3 * n * sizeof(double));
+  for (size_t s = 0; s < n; ++s) {
+    double* a = w->acc + 3 * s;
+    double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (len > 0.0 && isfinite(len)) {
+      nrm[3 * s] = a[0] / len;
+      nrm[3 * s + 1] = a[1] / len;
+      nrm[3 * s + 2] = a[2] / len;
+    }
+    double dx = nrm[3 * s] - old[3 * s], dy = nrm[3 * s + 1] - old[3 * s + 1],
+           dz = nrm[3 * s + 2] - old[3 * s + 2];
+    w->change[s] = sqrt(dx * dx + dy * dy + dz * dz);
+  }
+}
+
+dacpo_status
+dacpo_ipsr_block(const double* xyz,
+                 double* nrm,
+                 size_t n,
+                 size_t n_own,
+                 const dacpo_ipsr_params* params,
+                 dacpo_mesh* mesh_out,
+                 dacpo_ipsr_stats* stats,
+                 dacpo_err* err)
+{
+  const double t_start = dacpo_now();
+  dacpo_ipsr_stats st_local;
+  dacpo_ipsr_stats* st = stats ? stats : &st_local;
+  memset(st, 0, sizeof(*st));
+  if (mesh_out)
+    memset(mesh_out, 0, sizeof(*mesh_out));
+  DACPO_TRY(ipsr_check_args(xyz, nrm, n, n_own, params, err));
   /* A block this small has no surface to speak of: leave it alone. */
   if (n < 4)
     return DACPO_OK;
@@ -519,35 +609,9 @@ dacpo_ipsr_block(const double* xyz,
   if ((status = estimate_spacing(&w, xyz, n, &spacing, err)) != DACPO_OK)
     goto done;
 
-  dacpo_poisson_params pp;
-  dacpo_poisson_params_default(&pp);
-  pp.cell_per_spacing = params->cell_per_spacing;
-  pp.max_resolution = params->max_resolution;
-  pp.point_weight = params->point_weight;
-  if (params->padding > 0.0)
-    pp.padding = params->padding;
-  if (params->max_cells > 0)
-    pp.max_cells = params->max_cells;
-  if (params->tolerance > 0.0)
-    pp.tolerance = params->tolerance;
-  if (params->max_cg_iterations > 0)
-    pp.max_cg_iterations = params->max_cg_iterations;
-  pp.band = params->band;
-  if ((status = dacpo_poisson_create(xyz, w.area, n, spacing, &pp, &w.ps, err)) !=
-      DACPO_OK)
-    goto done;
-  if ((status = dacpo_mcubes_create(&w.mc, err)) != DACPO_OK)
+  if ((status = ipsr_setup(&w, xyz, n, spacing, params, st, err)) != DACPO_OK)
     goto done;
   const dacpo_grid* grid = dacpo_poisson_grid(w.ps);
-  st->resolution = grid->dims[0];
-  for (int a = 1; a < 3; ++a)
-    if (grid->dims[a] > st->resolution)
-      st->resolution = grid->dims[a];
-  st->spacing = spacing;
-  st->cell = grid->cell;
-  for (int a = 0; a < 3; ++a)
-    st->dims[a] = grid->dims[a];
-  st->domain_cells = dacpo_poisson_domain_cells(w.ps);
   const double far = params->trim_spacings * spacing;
   const double far2 = far * far;
 
@@ -588,35 +652,7 @@ dacpo_ipsr_block(const double* xyz,
     mesh_trimmed = trimming;
     if (iters == 0)
       break;
-    /* vote */
-    memset(w.acc, 0, 3 * n * sizeof(double));
-    for (size_t f = 0; f < mesh->num_triangles; ++f) {
-      if (w.removed[f])
-        continue;
-      const double* nf = w.fnrm + 3 * f;
-      const int32_t* nb = w.fknn + k * f;
-      for (size_t j = 0; j < k; ++j) {
-        if (nb[j] < 0)
-          break;
-        double* acc = w.acc + 3 * (size_t)nb[j];
-        acc[0] += nf[0];
-        acc[1] += nf[1];
-        acc[2] += nf[2];
-      }
-    }
-    memcpy(old, nrm, 3 * n * sizeof(double));
-    for (size_t s = 0; s < n; ++s) {
-      double* a = w.acc + 3 * s;
-      double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-      if (len > 0.0 && isfinite(len)) {
-        nrm[3 * s] = a[0] / len;
-        nrm[3 * s + 1] = a[1] / len;
-        nrm[3 * s + 2] = a[2] / len;
-      }
-      double dx = nrm[3 * s] - old[3 * s], dy = nrm[3 * s + 1] - old[3 * s + 1],
-             dz = nrm[3 * s + 2] - old[3 * s + 2];
-      w.change[s] = sqrt(dx * dx + dy * dy + dz * dz);
-    }
+    ipsr_vote(&w, mesh, k, nrm, old, n);
     double t3 = dacpo_now();
     st->solve_seconds += t1 - t0;
     st->extract_seconds += t2 - t1;
