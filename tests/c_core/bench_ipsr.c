@@ -11,11 +11,11 @@
  * summary (iterations mean/max, block and per-iteration CPU mean/max).
  *
  * Not a test. Build (from the repository root):
- *   gcc -std=c11 -O2 -Ic_core/include -Ic_core/src -Itests/support \
+ *   gcc -std=c11 -O2 -Ic_core/include -Ic_core/src -Iwrappers/support \
  *     tests/c_core/bench_ipsr.c c_core/src/dacpo_ipsr.c \
  *     c_core/src/dacpo_poisson.c c_core/src/dacpo_mcubes.c \
  *     c_core/src/dacpo_kdtree.c c_core/src/dacpo_context.c \
- *     tests/support/dacpo_ply.c -lm -o bench_ipsr
+ *     wrappers/support/dacpo_ply.c -lm -o bench_ipsr
  * Usage:
  *   bench_ipsr [-n points] [-flip share] [-blocks per_scan]
  *              [-cps cell_per_spacing] [-alpha point_weight] [-tol tolerance]

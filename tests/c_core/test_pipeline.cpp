@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // dacpo_orient() end to end, through the public C API only, on synthetic scenes
-// with known normals (tests/support/dacpo_scene.h): orientation error against
+// with known normals (wrappers/support/dacpo_scene.h): orientation error against
 // ground truth, the per-point / per-block / per-edge results and stats the
 // context publishes, determinism (seed, thread count, caller's search), the
 // progress callback's contract, and that the output keeps the caller's axes.

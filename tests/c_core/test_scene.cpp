@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Tests of the synthetic scene generator, the orientation score and the PLY
-// reader/writer in tests/support (dacpo_scene.c, dacpo_ply.c).
+// reader/writer in wrappers/support (dacpo_scene.c, dacpo_ply.c).
 #include <gtest/gtest.h>
 
 #include <cmath>

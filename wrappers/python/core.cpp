@@ -254,7 +254,7 @@ orient(FloatArray points,
   return r;
 }
 
-/* A generated scene with ground truth (tests/support/dacpo_scene.h). */
+/* A generated scene with ground truth (wrappers/support/dacpo_scene.h). */
 py::tuple
 makeScene(const std::string& kind, size_t points, uint64_t seed, double noise)
 {

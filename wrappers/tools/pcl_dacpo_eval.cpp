@@ -5,7 +5,7 @@
  * the largest connected component of the k = 10 nearest-neighbour graph only
  * (exact duplicates merged, graph symmetrized: the core's definition). A
  * predicted normal that is not finite, or exactly perpendicular, is wrong under
- * either sign (dacpo_score_oriented() in tests/support).
+ * either sign (dacpo_score_oriented() in wrappers/support).
  *
  * When the prediction carries pcl_dacpo_orient -labels fields (block, and
  * component), the error is split by where it comes from: inside the blocks
