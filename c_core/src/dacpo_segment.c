@@ -378,6 +378,102 @@ seg_grow(const dacpo_adjacency* adj,
   return qlen;
 }
 
+/* Points grouped by component (counting sort, ascending inside a component):
+ * component c holds idx[comp_start[c] .. comp_start[c + 1]). */
+static dacpo_status
+seg_group_by_component(size_t n,
+                       const int32_t* component,
+                       size_t num_components,
+                       size_t* comp_start,
+                       int32_t* idx,
+                       dacpo_err* err)
+{
+  for (size_t i = 0; i < n; ++i)
+    comp_start[(size_t)component[i] + 1]++;
+  for (size_t c = 0; c < num_components; ++c)
+    comp_start[c + 1] += comp_start[c];
+  size_t* cur = (size_t*)dacpo_malloc_array(num_components, sizeof(size_t));
+  if (cur == NULL)
+    return DACPO_OOM(err);
+  memcpy(cur, comp_start, num_components * sizeof(size_t));
+  for (size_t i = 0; i < n; ++i)
+    idx[cur[component[i]]++] = (int32_t)i;
+  free(cur);
+
+  return DACPO_OK;
+}
+
+/* Blocks per component: proportional to its size, at least 1, at most |c|/8
+ * (blocks of a handful of points carry no reliable orientation). Returns the
+ * total. */
+static size_t
+seg_blocks_per_component(const size_t* comp_start,
+                         size_t num_components,
+                         size_t n,
+                         size_t target_blocks,
+                         size_t* nblk)
+{
+  size_t total = 0;
+  for (size_t c = 0; c < num_components; ++c) {
+    size_t sz = comp_start[c + 1] - comp_start[c];
+    if (sz == 0)
+      continue;
+    size_t want = 1;
+    if (target_blocks > 0) {
+      double w = floor((double)target_blocks * (double)sz / (double)n + 0.5);
+      want = w < 1.0 ? 1 : (w > (double)sz ? sz : (size_t)w);
+    }
+    size_t cap = sz / 8 > 0 ? sz / 8 : 1;
+    if (want > cap)
+      want = cap;
+    nblk[c] = want;
+    total += want;
+  }
+
+  return total;
+}
+
+/* Dense block ids, component by component, seed order inside; empty raw
+ * blocks get remap -1. Sets res->num_blocks and res->component_of_block. */
+static dacpo_status
+seg_renumber(size_t num_raw,
+             const size_t* raw_size,
+             const int32_t* raw_comp,
+             size_t num_components,
+             dacpo_blocks* res,
+             int32_t* remap,
+             dacpo_err* err)
+{
+  /* raw blocks are already grouped by component except the extra ones, which
+   * come after all seeded blocks: a stable counting pass per component */
+  size_t* per_comp = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
+  if (per_comp == NULL)
+    return DACPO_OOM(err);
+  for (size_t r = 0; r < num_raw; ++r)
+    if (raw_size[r] > 0)
+      per_comp[(size_t)raw_comp[r] + 1]++;
+  for (size_t c = 0; c < num_components; ++c)
+    per_comp[c + 1] += per_comp[c];
+  res->num_blocks = per_comp[num_components];
+  res->component_of_block =
+      (int32_t*)dacpo_malloc_array(res->num_blocks, sizeof(int32_t));
+  if (res->component_of_block == NULL) {
+    free(per_comp);
+    return DACPO_OOM(err);
+  }
+  for (size_t r = 0; r < num_raw; ++r) {
+    if (raw_size[r] == 0) {
+      remap[r] = -1;
+      continue;
+    }
+    size_t id = per_comp[raw_comp[r]]++;
+    remap[r] = (int32_t)id;
+    res->component_of_block[id] = raw_comp[r];
+  }
+  free(per_comp);
+  return DACPO_OK;
+}
+
 dacpo_status
 dacpo_segment(const dacpo_cloud* cloud,
               const dacpo_adjacency* adj,
@@ -418,41 +514,12 @@ dacpo_segment(const dacpo_cloud* cloud,
     goto fail;
   }
 
-  /* Points grouped by component (counting sort, ascending inside a component). */
-  for (size_t i = 0; i < n; ++i)
-    comp_start[(size_t)component[i] + 1]++;
-  for (size_t c = 0; c < num_components; ++c)
-    comp_start[c + 1] += comp_start[c];
-  {
-    size_t* cur = (size_t*)dacpo_malloc_array(num_components, sizeof(size_t));
-    if (cur == NULL) {
-      st = DACPO_OOM(err);
-      goto fail;
-    }
-    memcpy(cur, comp_start, num_components * sizeof(size_t));
-    for (size_t i = 0; i < n; ++i)
-      sp.idx[cur[component[i]]++] = (int32_t)i;
-    free(cur);
-  }
+  if ((st = seg_group_by_component(
+           n, component, num_components, comp_start, sp.idx, err)) != DACPO_OK)
+    goto fail;
 
-  /* Blocks per component: proportional to its size, at least 1, at most |c|/8
-   * (blocks of a handful of points carry no reliable orientation). */
-  size_t total = 0;
-  for (size_t c = 0; c < num_components; ++c) {
-    size_t sz = comp_start[c + 1] - comp_start[c];
-    if (sz == 0)
-      continue;
-    size_t want = 1;
-    if (target_blocks > 0) {
-      double w = floor((double)target_blocks * (double)sz / (double)n + 0.5);
-      want = w < 1.0 ? 1 : (w > (double)sz ? sz : (size_t)w);
-    }
-    size_t cap = sz / 8 > 0 ? sz / 8 : 1;
-    if (want > cap)
-      want = cap;
-    nblk[c] = want;
-    total += want;
-  }
+  const size_t total =
+      seg_blocks_per_component(comp_start, num_components, n, target_blocks, nblk);
 
   /* Seeds, component by component. Unreached points (see below) may add at most
    * n - total further blocks, so n slots are enough for all raw blocks. */
@@ -519,38 +586,9 @@ dacpo_segment(const dacpo_cloud* cloud,
   }
   for (size_t i = 0; i < n; ++i)
     raw_size[res.block_of[i]]++;
-  {
-    /* raw blocks are already grouped by component except the extra ones, which
-     * come after all seeded blocks: a stable counting pass per component */
-    size_t* per_comp = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
-    if (per_comp == NULL) {
-      st = DACPO_OOM(err);
-      goto fail;
-    }
-    for (size_t r = 0; r < num_raw; ++r)
-      if (raw_size[r] > 0)
-        per_comp[(size_t)raw_comp[r] + 1]++;
-    for (size_t c = 0; c < num_components; ++c)
-      per_comp[c + 1] += per_comp[c];
-    res.num_blocks = per_comp[num_components];
-    res.component_of_block =
-        (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
-    if (res.component_of_block == NULL) {
-      free(per_comp);
-      st = DACPO_OOM(err);
-      goto fail;
-    }
-    for (size_t r = 0; r < num_raw; ++r) {
-      if (raw_size[r] == 0) {
-        remap[r] = -1;
-        continue;
-      }
-      size_t id = per_comp[raw_comp[r]]++;
-      remap[r] = (int32_t)id;
-      res.component_of_block[id] = raw_comp[r];
-    }
-    free(per_comp);
-  }
+  if ((st = seg_renumber(
+           num_raw, raw_size, raw_comp, num_components, &res, remap, err)) != DACPO_OK)
+    goto fail;
   for (size_t i = 0; i < n; ++i)
     res.block_of[i] = remap[res.block_of[i]];
 
