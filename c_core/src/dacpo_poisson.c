@@ -814,24 +814,10 @@ vcycle(dacpo_poisson* ps, size_t l, float* x, const float* b)
 
 /* ------------------------------------------------------------------------ */
 
-dacpo_status
-dacpo_poisson_create(const double* xyz,
-                     const double* area,
-                     size_t n,
-                     double spacing,
-                     const dacpo_poisson_params* params,
-                     dacpo_poisson** out,
-                     dacpo_err* err)
+/* The parameters dacpo_poisson_create accepts. */
+static dacpo_status
+ps_check_params(double spacing, const dacpo_poisson_params* params, dacpo_err* err)
 {
-  DACPO_CHECK(err, out, DACPO_ERR_INVALID_ARGUMENT, "poisson: out is NULL");
-  *out = NULL;
-  DACPO_CHECK(err, xyz && params, DACPO_ERR_INVALID_ARGUMENT, "poisson: NULL argument");
-  DACPO_CHECK(err, n > 0, DACPO_ERR_INVALID_ARGUMENT, "poisson: no samples");
-  DACPO_CHECK(err,
-              n <= (size_t)INT32_MAX,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "poisson: %zu samples exceed int32 indices",
-              n);
   DACPO_CHECK(err,
               isfinite(spacing) && spacing > 0.0,
               DACPO_ERR_INVALID_ARGUMENT,
@@ -872,6 +858,87 @@ dacpo_poisson_create(const double* xyz,
               DACPO_ERR_INVALID_ARGUMENT,
               "poisson: band must be <= 256 cells (got %zu)",
               params->band);
+
+  return DACPO_OK;
+}
+
+/* Samples in cell units and their screening weights alpha * area (areas
+ * relative to a cell face; all-zero areas fall back to uniform ones). */
+static void
+ps_set_samples(dacpo_poisson* ps,
+               const double* xyz,
+               const double* area,
+               size_t n,
+               double spacing,
+               double alpha)
+{
+  const dacpo_grid* g = &ps->grid;
+  const double h = g->cell;
+  ps->wsum = 0.0;
+  for (size_t s = 0; s < n; ++s) {
+    for (int a = 0; a < 3; ++a)
+      ps->u[3 * s + a] = (xyz[3 * s + a] - g->origin[a]) / h;
+    double ar = area ? area[s] / (h * h) : (spacing * spacing) / (h * h);
+    ps->area[s] = ar;
+    ps->w[s] = alpha * ar;
+    ps->wsum += ar;
+  }
+  if (!(ps->wsum > 0.0)) {
+    /* all areas zero: fall back to uniform weights */
+    for (size_t s = 0; s < n; ++s) {
+      ps->area[s] = (spacing * spacing) / (h * h);
+      ps->w[s] = alpha * ps->area[s];
+    }
+    ps->wsum = (double)n * ps->area[0];
+  }
+}
+
+/* Multigrid level l: sizes, stencil offsets, domain and screening, and (l > 0)
+ * its solution and right-hand side. */
+static dacpo_status
+ps_build_level(dacpo_poisson* ps, size_t l, size_t band, dacpo_err* err)
+{
+  mg_level* L = &ps->lv[l];
+  for (int a = 0; a < 3; ++a)
+    L->n[a] = ps->grid.dims[a] >> l;
+  L->cells = L->n[0] * L->n[1] * L->n[2];
+  L->c = (float)((size_t)1 << l);
+  const ptrdiff_t sx = 1, sy = (ptrdiff_t)L->n[0], sz = (ptrdiff_t)(L->n[0] * L->n[1]);
+  for (int o = 0; o < 27; ++o)
+    L->off[o] = (ptrdiff_t)(o % 3 - 1) * sx + (ptrdiff_t)((o / 3) % 3 - 1) * sy +
+                (ptrdiff_t)(o / 9 - 1) * sz;
+  L->nb[0] = -sx, L->nb[1] = sx, L->nb[2] = -sy, L->nb[3] = sy, L->nb[4] = -sz,
+  L->nb[5] = sz;
+  DACPO_TRY(l == 0 ? build_domain0(ps, band, err) : build_domain_coarse(ps, l, err));
+  DACPO_TRY(build_screening(ps, L, 1.0 / (double)((size_t)1 << l), err));
+  if (l > 0) {
+    L->x = (float*)ps_alloc(ps, L->cells, sizeof(float), 1);
+    L->b = (float*)ps_alloc(ps, L->cells, sizeof(float), 1);
+    if (!L->x || !L->b)
+      return DACPO_OOM(err);
+  }
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_poisson_create(const double* xyz,
+                     const double* area,
+                     size_t n,
+                     double spacing,
+                     const dacpo_poisson_params* params,
+                     dacpo_poisson** out,
+                     dacpo_err* err)
+{
+  DACPO_CHECK(err, out, DACPO_ERR_INVALID_ARGUMENT, "poisson: out is NULL");
+  *out = NULL;
+  DACPO_CHECK(err, xyz && params, DACPO_ERR_INVALID_ARGUMENT, "poisson: NULL argument");
+  DACPO_CHECK(err, n > 0, DACPO_ERR_INVALID_ARGUMENT, "poisson: no samples");
+  DACPO_CHECK(err,
+              n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: %zu samples exceed int32 indices",
+              n);
+  DACPO_TRY(ps_check_params(spacing, params, err));
 
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
          hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -914,7 +981,6 @@ dacpo_poisson_create(const double* xyz,
     goto fail;
   }
   const dacpo_grid* g = &ps->grid;
-  const double h = g->cell;
   size_t dmax = g->dims[0];
   for (int a = 1; a < 3; ++a)
     if (g->dims[a] > dmax)
@@ -932,52 +998,11 @@ dacpo_poisson_create(const double* xyz,
     st = DACPO_OOM(err);
     goto fail;
   }
-  ps->wsum = 0.0;
-  for (size_t s = 0; s < n; ++s) {
-    for (int a = 0; a < 3; ++a)
-      ps->u[3 * s + a] = (xyz[3 * s + a] - g->origin[a]) / h;
-    double ar = area ? area[s] / (h * h) : (spacing * spacing) / (h * h);
-    ps->area[s] = ar;
-    ps->w[s] = alpha * ar;
-    ps->wsum += ar;
-  }
-  if (!(ps->wsum > 0.0)) {
-    /* all areas zero: fall back to uniform weights */
-    for (size_t s = 0; s < n; ++s) {
-      ps->area[s] = (spacing * spacing) / (h * h);
-      ps->w[s] = alpha * ps->area[s];
-    }
-    ps->wsum = (double)n * ps->area[0];
-  }
+  ps_set_samples(ps, xyz, area, n, spacing, alpha);
 
-  for (size_t l = 0; l < ps->levels; ++l) {
-    mg_level* L = &ps->lv[l];
-    for (int a = 0; a < 3; ++a)
-      L->n[a] = g->dims[a] >> l;
-    L->cells = L->n[0] * L->n[1] * L->n[2];
-    L->c = (float)((size_t)1 << l);
-    const ptrdiff_t sx = 1, sy = (ptrdiff_t)L->n[0],
-                    sz = (ptrdiff_t)(L->n[0] * L->n[1]);
-    for (int o = 0; o < 27; ++o)
-      L->off[o] = (ptrdiff_t)(o % 3 - 1) * sx + (ptrdiff_t)((o / 3) % 3 - 1) * sy +
-                  (ptrdiff_t)(o / 9 - 1) * sz;
-    L->nb[0] = -sx, L->nb[1] = sx, L->nb[2] = -sy, L->nb[3] = sy, L->nb[4] = -sz,
-    L->nb[5] = sz;
-    st =
-        l == 0 ? build_domain0(ps, params->band, err) : build_domain_coarse(ps, l, err);
-    if (st != DACPO_OK)
+  for (size_t l = 0; l < ps->levels; ++l)
+    if ((st = ps_build_level(ps, l, params->band, err)) != DACPO_OK)
       goto fail;
-    if ((st = build_screening(ps, L, 1.0 / (double)((size_t)1 << l), err)) != DACPO_OK)
-      goto fail;
-    if (l > 0) {
-      L->x = (float*)ps_alloc(ps, L->cells, sizeof(float), 1);
-      L->b = (float*)ps_alloc(ps, L->cells, sizeof(float), 1);
-      if (!L->x || !L->b) {
-        st = DACPO_OOM(err);
-        goto fail;
-      }
-    }
-  }
   for (size_t s = 0; s < n; ++s)
     cell_stencil(ps->lv[0].n, ps->u + 3 * s, ps->sc + 8 * s, ps->sw + 8 * s);
 
