@@ -589,29 +589,20 @@ br_copy_adjacency(const dacpo_adjacency* adj, dacpo_adjacency* out, dacpo_err* e
 
 /* ---- entry point ---------------------------------------------------------- */
 
-dacpo_status
-dacpo_bridge_components(const dacpo_cloud* cloud,
-                        const dacpo_adjacency* adj,
-                        int32_t* component,
-                        size_t num_components,
-                        size_t extra,
-                        dacpo_adjacency* out,
-                        size_t* bridges_added,
-                        double* longest_bridge,
-                        dacpo_err* err)
+/* The arguments dacpo_bridge_components accepts. */
+static dacpo_status
+br_check_args(const dacpo_cloud* cloud,
+              const dacpo_adjacency* adj,
+              const int32_t* component,
+              size_t num_components,
+              size_t extra,
+              dacpo_err* err)
 {
-  DACPO_CHECK(err,
-              out != NULL && bridges_added != NULL && longest_bridge != NULL,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "bridge: NULL output argument");
-  memset(out, 0, sizeof(*out));
-  *bridges_added = 0;
-  *longest_bridge = 0.0;
   DACPO_CHECK(err,
               cloud != NULL && adj != NULL,
               DACPO_ERR_INVALID_ARGUMENT,
               "bridge: NULL cloud or adjacency");
-  size_t n = cloud->n;
+  const size_t n = cloud->n;
   DACPO_CHECK(err,
               adj->n == n,
               DACPO_ERR_INVALID_ARGUMENT,
@@ -647,6 +638,29 @@ dacpo_bridge_components(const dacpo_cloud* cloud,
                 i,
                 (int)component[i],
                 num_components);
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_bridge_components(const dacpo_cloud* cloud,
+                        const dacpo_adjacency* adj,
+                        int32_t* component,
+                        size_t num_components,
+                        size_t extra,
+                        dacpo_adjacency* out,
+                        size_t* bridges_added,
+                        double* longest_bridge,
+                        dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              out != NULL && bridges_added != NULL && longest_bridge != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "bridge: NULL output argument");
+  memset(out, 0, sizeof(*out));
+  *bridges_added = 0;
+  *longest_bridge = 0.0;
+  DACPO_TRY(br_check_args(cloud, adj, component, num_components, extra, err));
+  size_t n = cloud->n;
   if (num_components <= 1)
     return br_copy_adjacency(adj, out, err);
 
