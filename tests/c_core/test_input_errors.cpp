@@ -577,6 +577,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_orders", [](dacpo_params* p) { p->dipole_orders = 0; }},
       {"dipole_neighbors", [](dacpo_params* p) { p->dipole_neighbors = 0; }},
       {"dipole_noise_band", [](dacpo_params* p) { p->dipole_noise_band = -1.0; }},
+      {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = -1.0; }},
+      {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = std::nan(""); }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},
   };
   auto ctx = makeCtx();
