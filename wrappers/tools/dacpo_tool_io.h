@@ -48,9 +48,7 @@ extension(const std::string& path)
 /** Positional .pcd/.ply arguments in command-line order; values of the options
  *  named in \a value_options (e.g. "-colored out.pcd") are not positional. */
 inline std::vector<std::string>
-fileArguments(int argc,
-              char** argv,
-              std::initializer_list<const char*> value_options = {})
+fileArguments(int argc, char** argv, const std::vector<const char*>& value_options = {})
 {
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
@@ -94,11 +92,11 @@ editDistance(const std::string& a, const std::string& b)
 inline bool
 checkArguments(int argc,
                char** argv,
-               std::initializer_list<const char*> switches,
-               std::initializer_list<const char*> valued,
+               const std::vector<const char*>& switches,
+               const std::vector<const char*>& valued,
                std::string& error)
 {
-  auto in = [](std::initializer_list<const char*> list, const std::string& a) {
+  auto in = [](const std::vector<const char*>& list, const std::string& a) {
     return std::any_of(list.begin(), list.end(), [&](const char* o) { return a == o; });
   };
   for (int i = 1; i < argc; ++i) {
@@ -115,8 +113,8 @@ checkArguments(int argc,
       const std::size_t first = a.find_first_not_of('-');
       const std::string bare =
           first == std::string::npos ? std::string() : a.substr(first);
-      for (auto list : {switches, valued})
-        for (const char* o : list) {
+      for (const std::vector<const char*>* list : {&switches, &valued})
+        for (const char* o : *list) {
           const std::size_t d =
               std::min(editDistance(a, o), editDistance("-" + bare, o));
           if (d < best_d) {

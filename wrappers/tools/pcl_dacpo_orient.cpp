@@ -29,6 +29,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -77,6 +78,9 @@ struct Options {
   std::string normals_colored;       /* -normals_colored file.{pcd,ply} */
   std::string input_dir, output_dir; /* batch mode */
   std::string mesh;                  /* -mesh file.ply */
+  std::string sign;                  /* -sign free|keep */
+  std::string viewpoint;             /* -vp x,y,z */
+  bool separate = false, bridge = false;
 };
 
 /* What a run leaves for the diagnostics, in output (= input) point order. */
@@ -95,6 +99,323 @@ struct Result {
  * labels of an earlier run would be stale. */
 const std::vector<std::string> kLabelFields = {"block", "component", "flip"};
 
+/* One command-line option. The help text, the parser and the unknown-option
+ * check all read the table below (kOptions), so an option is named once. */
+struct OptionSpec {
+  const char* name;
+  const char* arg;  /* nullptr: a switch; else the value's placeholder in -h */
+  const char* help; /* '\n' starts a continuation line */
+  /* the default shown in -h; nullptr: none */
+  std::string (*shown)(const dacpo_params&);
+  /* sets the options from the value (a switch gets ""); false + error */
+  bool (*apply)(Options&, const std::string&, std::string&);
+};
+
+bool
+toUnsigned(const std::string& s, std::uint64_t& v)
+{
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long r = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || *end || errno || s[0] == '-')
+    return false;
+  v = r;
+  return true;
+}
+
+bool
+toDouble(const std::string& s, double& v)
+{
+  char* end = nullptr;
+  errno = 0;
+  const double r = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end || errno || !std::isfinite(r))
+    return false;
+  v = r;
+  return true;
+}
+
+/* Setters for fields of dacpo_params, by type. */
+template <typename T, T dacpo_params::*Field>
+bool
+setUnsigned(Options& o, const std::string& s, std::string& error)
+{
+  std::uint64_t v = 0;
+  if (!toUnsigned(s, v) ||
+      v > static_cast<std::uint64_t>(std::numeric_limits<T>::max())) {
+    error = "expects a non-negative integer, got '" + s + "'";
+    return false;
+  }
+  o.params.*Field = static_cast<T>(v);
+  return true;
+}
+
+template <double dacpo_params::*Field>
+bool
+setDouble(Options& o, const std::string& s, std::string& error)
+{
+  double v = 0.0;
+  if (!toDouble(s, v)) {
+    error = "expects a number, got '" + s + "'";
+    return false;
+  }
+  o.params.*Field = v;
+  return true;
+}
+
+template <typename T, T dacpo_params::*Field>
+std::string
+showNumber(const dacpo_params& d)
+{
+  std::ostringstream out;
+  out << d.*Field;
+  return out.str();
+}
+
+/* Options whose value is kept as given and checked in finishOptions(). */
+template <std::string Options::*Field>
+bool
+setText(Options& o, const std::string& s, std::string&)
+{
+  o.*Field = s;
+  return true;
+}
+
+template <bool Options::*Field>
+bool
+setFlag(Options& o, const std::string&, std::string&)
+{
+  o.*Field = true;
+  return true;
+}
+
+const OptionSpec kOptions[] = {
+    {"-k",
+     "X",
+     "neighbours of the k-NN graph",
+     showNumber<size_t, &dacpo_params::k>,
+     setUnsigned<size_t, &dacpo_params::k>},
+    {"-normal_k",
+     "X",
+     "neighbours of PCA normals when estimated",
+     showNumber<size_t, &dacpo_params::normal_k>,
+     setUnsigned<size_t, &dacpo_params::normal_k>},
+    {"-estimate",
+     nullptr,
+     "estimate PCA normals even if the input has normal_x/y/z\n"
+     "(without normals in the input they are always estimated)",
+     nullptr,
+     setFlag<&Options::estimate>},
+    {"-blocks",
+     "X",
+     "number of blocks, 0 = automatic",
+     showNumber<size_t, &dacpo_params::num_blocks>,
+     setUnsigned<size_t, &dacpo_params::num_blocks>},
+    {"-c",
+     "X",
+     "dipole constant c (paper Eq. 1): 4 clean, 2 noisy,\n1.2-1.5 depth frames",
+     showNumber<double, &dacpo_params::dipole_c>,
+     setDouble<&dacpo_params::dipole_c>},
+    {"-vcr_size",
+     "X",
+     "VCR image side in pixels",
+     showNumber<size_t, &dacpo_params::vcr_image_size>,
+     setUnsigned<size_t, &dacpo_params::vcr_image_size>},
+    {"-vcr_views",
+     "X",
+     "VCR views",
+     showNumber<size_t, &dacpo_params::vcr_views>,
+     setUnsigned<size_t, &dacpo_params::vcr_views>},
+    {"-vcr_perspective",
+     nullptr,
+     "perspective VCR projection (default: orthographic)",
+     nullptr,
+     [](Options& o, const std::string&, std::string&) {
+       o.params.vcr_perspective = 1;
+       return true;
+     }},
+    {"-vcr_c1c2",
+     nullptr,
+     "VCR score C1*C2 without the boundary factor C_B",
+     nullptr,
+     [](Options& o, const std::string&, std::string&) {
+       o.params.vcr_boundary_factor = 0;
+       return true;
+     }},
+    {"-mesh",
+     "F.ply",
+     "also write the reconstructed surface (trimmed iPSR\n"
+     "block meshes, wound like the output normals)",
+     nullptr,
+     setText<&Options::mesh>},
+    {"-sign",
+     "free|keep",
+     "global sign: normals face the free space the scan\n"
+     "was seen from (free, default; closed objects: outward),\n"
+     "or the arbitrary one of the method (keep)",
+     nullptr,
+     setText<&Options::sign>},
+    {"-vp",
+     "x,y,z",
+     "most normals face this viewpoint (one sign for the whole\n"
+     "cloud, consistency is kept)",
+     nullptr,
+     setText<&Options::viewpoint>},
+    {"-separate",
+     nullptr,
+     "disconnected parts keep the sign they got (undefined relative sign)\n"
+     "(default: each part takes the sign that faces the viewpoint\n"
+     "implied by the largest part)",
+     nullptr,
+     [](Options& o, const std::string&, std::string&) {
+       o.separate = true;
+       return true;
+     }},
+    {"-weak",
+     "X",
+     "block edges with less than X times the typical evidence\n"
+     "leave their blocks to the viewpoint vote, 0 = only\n"
+     "disconnected parts",
+     showNumber<double, &dacpo_params::weak_edge_fraction>,
+     setDouble<&dacpo_params::weak_edge_fraction>},
+    {"-bridge",
+     nullptr,
+     "join disconnected parts along their minimum spanning tree\n"
+     "and orient them as one",
+     nullptr,
+     [](Options& o, const std::string&, std::string&) {
+       o.bridge = true;
+       return true;
+     }},
+    {"-band",
+     "X",
+     "dipole noise band, 0 = off",
+     showNumber<double, &dacpo_params::dipole_noise_band>,
+     setDouble<&dacpo_params::dipole_noise_band>},
+    {"-two_sheet",
+     "X",
+     "thin parts: neighbours off each other's tangent plane by\n"
+     "more than X times the local noise are two sheets that\n"
+     "face opposite ways, 0 = off",
+     showNumber<double, &dacpo_params::dipole_two_sheet>,
+     setDouble<&dacpo_params::dipole_two_sheet>},
+    {"-orders",
+     "X",
+     "randomized dipole propagation orders",
+     showNumber<size_t, &dacpo_params::dipole_orders>,
+     setUnsigned<size_t, &dacpo_params::dipole_orders>},
+    {"-restarts",
+     "X",
+     "dipole runs per block, the most self-consistent kept",
+     showNumber<size_t, &dacpo_params::dipole_restarts>,
+     setUnsigned<size_t, &dacpo_params::dipole_restarts>},
+    {"-ring",
+     "X",
+     "block overlap ring in k-NN hops",
+     showNumber<size_t, &dacpo_params::ring_hops>,
+     setUnsigned<size_t, &dacpo_params::ring_hops>},
+    {"-no_ipsr",
+     nullptr,
+     "skip the iterative Poisson refinement",
+     nullptr,
+     [](Options& o, const std::string&, std::string&) {
+       o.params.ipsr_enabled = 0;
+       return true;
+     }},
+    {"-weights",
+     "S",
+     "block edge weights: vcr | dipole | overlap",
+     [](const dacpo_params& d) -> std::string {
+       return d.edge_weight == DACPO_WEIGHT_VCR       ? "vcr"
+              : d.edge_weight == DACPO_WEIGHT_OVERLAP ? "overlap"
+                                                      : "dipole";
+     },
+     [](Options& o, const std::string& s, std::string& error) {
+       if (s == "dipole")
+         o.params.edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
+       else if (s == "vcr")
+         o.params.edge_weight = DACPO_WEIGHT_VCR;
+       else if (s == "overlap")
+         o.params.edge_weight = DACPO_WEIGHT_OVERLAP;
+       else {
+         error = "must be vcr, dipole or overlap, got '" + s + "'";
+         return false;
+       }
+       return true;
+     }},
+    {"-time_limit",
+     "X",
+     "seconds for the 0-1 program",
+     showNumber<double, &dacpo_params::solver_time_limit>,
+     setDouble<&dacpo_params::solver_time_limit>},
+    {"-seed",
+     "X",
+     "random seed",
+     showNumber<std::uint64_t, &dacpo_params::seed>,
+     setUnsigned<std::uint64_t, &dacpo_params::seed>},
+    {"-threads",
+     "X",
+     "worker threads, 0 = all cores",
+     showNumber<unsigned, &dacpo_params::num_threads>,
+     [](Options& o, const std::string& s, std::string& error) {
+       std::uint64_t v = 0;
+       if (!toUnsigned(s, v)) {
+         error = "expects a non-negative integer, got '" + s + "'";
+         return false;
+       }
+       if (v > 4096) {
+         error = s + " is too large";
+         return false;
+       }
+       o.params.num_threads = static_cast<unsigned>(v);
+       return true;
+     }},
+    {"-labels",
+     nullptr,
+     "add int32 fields block, component and flip, and the\n"
+     "float field confidence (0..1, how sure the sign is)\n"
+     "(flip = 1 if the 0-1 program flipped the block;\n"
+     "all -1 for skipped points); then pcl_dacpo_eval\n"
+     "splits the error into in-block and block-flip parts",
+     nullptr,
+     setFlag<&Options::labels>},
+    {"-edges",
+     "F.csv",
+     "write the block-graph edges: block_a,block_b,\n"
+     "alpha,alpha_bar,confidence,flipped_a,flipped_b;\n"
+     "list the weakest edges (confidence < 0.2)",
+     nullptr,
+     setText<&Options::edges>},
+    {"-blocks_colored",
+     "F.{pcd,ply}",
+     "PointXYZRGB, one colour per block,\n"
+     "darker if flipped, grey if skipped",
+     nullptr,
+     setText<&Options::blocks_colored>},
+    {"-normals_colored",
+     "F.{pcd,ply}",
+     "PointXYZRGBNormal coloured by\n"
+     "the normal's direction, RGB = (n + 1) / 2: a flipped\n"
+     "region shows in the complementary colour",
+     nullptr,
+     setText<&Options::normals_colored>},
+    {"-input_dir",
+     "D",
+     "batch: every .pcd/.ply of D to the same name in -output_dir",
+     nullptr,
+     setText<&Options::input_dir>},
+    {"-output_dir",
+     "O",
+     "batch: the output folder (created if missing)",
+     nullptr,
+     setText<&Options::output_dir>},
+    {"-q",
+     nullptr,
+     "quiet: errors and the final stats line only",
+     nullptr,
+     setFlag<&Options::quiet>},
+};
+
 void
 printHelp(int, char** argv)
 {
@@ -106,149 +427,24 @@ printHelp(int, char** argv)
   print_info("  written (replaced if present). PCD is written binary compressed, PLY "
              "binary.\n");
   print_info("  where options are:\n");
-  print_info(
-      "                     -k X        = neighbours of the k-NN graph (default: ");
-  print_value("%zu", d.k);
-  print_info(")\n");
-  print_info("                     -normal_k X = neighbours of PCA normals when "
-             "estimated (default: ");
-  print_value("%zu", d.normal_k);
-  print_info(")\n");
-  print_info("                     -estimate   = estimate PCA normals even if the "
-             "input has normal_x/y/z\n");
-  print_info("                                   (without normals in the input they "
-             "are always estimated)\n");
-  print_info(
-      "                     -blocks X   = number of blocks, 0 = automatic (default: ");
-  print_value("%zu", d.num_blocks);
-  print_info(")\n");
-  print_info("                     -c X        = dipole constant c (paper Eq. 1): 4 "
-             "clean, 2 noisy,\n"
-             "                                   1.2-1.5 depth frames (default: ");
-  print_value("%g", d.dipole_c);
-  print_info(")\n");
-  print_info("                     -vcr_size X = VCR image side in pixels (default: ");
-  print_value("%zu", d.vcr_image_size);
-  print_info(")\n");
-  print_info("                     -vcr_views X = VCR views (default: ");
-  print_value("%zu", d.vcr_views);
-  print_info(")\n");
-  print_info("                     -vcr_perspective = perspective VCR projection "
-             "(default: orthographic)\n");
-  print_info("                     -vcr_c1c2   = VCR score C1*C2 without the boundary "
-             "factor C_B\n");
-  print_info("                     -mesh F.ply = also write the reconstructed surface "
-             "(trimmed iPSR\n"
-             "                                   block meshes, wound like the output "
-             "normals)\n");
-  print_info(
-      "                     -sign free|keep = global sign: normals face the free "
-      "space the scan\n"
-      "                                   was seen from (free, default; closed "
-      "objects: outward),\n"
-      "                                   or the arbitrary one of the method (keep)\n");
-  print_info(
-      "                     -vp x,y,z   = most normals face this viewpoint (one sign "
-      "for the whole\n"
-      "                                   cloud, consistency is kept)\n");
-  print_info(
-      "                     -separate   = disconnected parts keep the sign they "
-      "got (undefined relative sign)\n"
-      "                                   (default: each part takes the sign that "
-      "faces the viewpoint\n"
-      "                                   implied by the largest part)\n");
-  print_info(
-      "                     -weak X     = block edges with less than X times the "
-      "typical evidence\n"
-      "                                   leave their blocks to the viewpoint vote, "
-      "0 = only\n"
-      "                                   disconnected parts (default: ");
-  print_value("%g", d.weak_edge_fraction);
-  print_info(")\n");
-  print_info("                     -bridge     = join disconnected parts along their "
-             "minimum spanning tree\n"
-             "                                   and orient them as one\n");
-  print_info(
-      "                     -band X     = dipole noise band, 0 = off (default: ");
-  print_value("%g", d.dipole_noise_band);
-  print_info(")\n");
-  print_info(
-      "                     -two_sheet X = thin parts: neighbours off each other's "
-      "tangent plane by\n"
-      "                                   more than X times the local noise are two "
-      "sheets that\n"
-      "                                   face opposite ways, 0 = off (default: ");
-  print_value("%g", d.dipole_two_sheet);
-  print_info(")\n");
-  print_info("                     -orders X   = randomized dipole propagation orders "
-             "(default: ");
-  print_value("%zu", d.dipole_orders);
-  print_info(")\n");
-  print_info("                     -restarts X = dipole runs per block, the most "
-             "self-consistent kept (default: ");
-  print_value("%zu", d.dipole_restarts);
-  print_info(")\n");
-  print_info(
-      "                     -ring X     = block overlap ring in k-NN hops (default: ");
-  print_value("%zu", d.ring_hops);
-  print_info(")\n");
-  print_info(
-      "                     -no_ipsr    = skip the iterative Poisson refinement\n");
-  print_info(
-      "                     -weights S  = block edge weights: vcr | dipole | overlap "
-      "(default: ");
-  print_value("%s",
-              d.edge_weight == DACPO_WEIGHT_VCR
-                  ? "vcr"
-                  : (d.edge_weight == DACPO_WEIGHT_OVERLAP ? "overlap" : "dipole"));
-  print_info(")\n");
-  print_info(
-      "                     -time_limit X = seconds for the 0-1 program (default: ");
-  print_value("%g", d.solver_time_limit);
-  print_info(")\n");
-  print_info("                     -seed X     = random seed (default: ");
-  print_value("%llu", static_cast<unsigned long long>(d.seed));
-  print_info(")\n");
-  print_info(
-      "                     -threads X  = worker threads, 0 = all cores (default: ");
-  print_value("%u", d.num_threads);
-  print_info(")\n");
-  print_info(
-      "                     -labels     = add int32 fields block, component "
-      "and flip, and the\n"
-      "                                   float field confidence (0..1, how sure the "
-      "sign is)\n");
-  print_info("                                   (flip = 1 if the 0-1 program flipped "
-             "the block;\n");
-  print_info("                                   all -1 for skipped points); then "
-             "pcl_dacpo_eval\n");
-  print_info("                                   splits the error into in-block and "
-             "block-flip parts\n");
-  print_info("                     -edges F.csv = write the block-graph edges: block_a,"
-             "block_b,\n");
-  print_info("                                   alpha,alpha_bar,confidence,flipped_a,"
-             "flipped_b;\n");
-  print_info(
-      "                                   list the weakest edges (confidence < ");
-  print_value("%g", kLowConfidence);
-  print_info(")\n");
-  print_info("                     -blocks_colored F.{pcd,ply} = PointXYZRGB, one "
-             "colour per block,\n");
-  print_info("                                   darker if flipped, grey if skipped\n");
-  print_info(
-      "                     -normals_colored F.{pcd,ply} = PointXYZRGBNormal "
-      "coloured by\n"
-      "                                   the normal's direction, RGB = (n + 1) / 2: "
-      "a flipped\n"
-      "                                   region shows in the complementary colour\n");
-  print_info(
-      "                     -input_dir D -output_dir O = batch: every .pcd/.ply "
-      "of D to the\n"
-      "                                   same name in O (created if missing); no "
-      "file arguments\n");
-  print_info(
-      "                     -q          = quiet: errors and the final stats line "
-      "only\n");
+  for (const OptionSpec& spec : kOptions) {
+    std::string head = spec.name;
+    if (spec.arg)
+      head += std::string(" ") + spec.arg;
+    if (head.size() < 11)
+      head.resize(11, ' ');
+    std::string text = spec.help;
+    for (std::size_t at = text.find('\n'); at != std::string::npos;
+         at = text.find('\n', at + 1))
+      text.insert(at + 1, 35, ' ');
+    print_info("                     %s = %s", head.c_str(), text.c_str());
+    if (spec.shown) {
+      print_info(" (default: ");
+      print_value("%s", spec.shown(d).c_str());
+      print_info(")");
+    }
+    print_info("\n");
+  }
   print_info("  After a successful run the last line on stderr is always\n");
   print_info("  \"stats: points=... blocks=... edges=... ... seconds=... "
              "peak_rss_mb=...\".\n");
@@ -692,94 +888,74 @@ saveMesh(const std::string& filename, const Result& r)
   return true;
 }
 
+const OptionSpec*
+findOption(const char* name)
+{
+  for (const OptionSpec& spec : kOptions)
+    if (std::strcmp(spec.name, name) == 0)
+      return &spec;
+  return nullptr;
+}
+
+/* The switches and the options that take a value, for dacpo_tool::checkArguments
+ * and dacpo_tool::fileArguments. */
+std::vector<const char*>
+optionNames(bool with_value)
+{
+  std::vector<const char*> names;
+  for (const OptionSpec& spec : kOptions)
+    if ((spec.arg != nullptr) == with_value)
+      names.push_back(spec.name);
+  return names;
+}
+
 bool
 parseOptions(int argc, char** argv, Options& o)
 {
   dacpo_params_init(&o.params);
-  std::string error;
-  std::uint64_t vcr_size = o.params.vcr_image_size, vcr_views = o.params.vcr_views;
-  std::uint64_t k = o.params.k, normal_k = o.params.normal_k,
-                blocks = o.params.num_blocks, orders = o.params.dipole_orders,
-                ring = o.params.ring_hops, seed = o.params.seed,
-                threads = o.params.num_threads, restarts = o.params.dipole_restarts;
-  double c = o.params.dipole_c, time_limit = o.params.solver_time_limit,
-         band = o.params.dipole_noise_band, weak = o.params.weak_edge_fraction,
-         two_sheet = o.params.dipole_two_sheet;
-  if (!dacpo_tool::parseUnsigned(argc, argv, "-vcr_size", vcr_size, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-vcr_views", vcr_views, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-k", k, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-normal_k", normal_k, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-blocks", blocks, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-orders", orders, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-restarts", restarts, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-ring", ring, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-seed", seed, error) ||
-      !dacpo_tool::parseUnsigned(argc, argv, "-threads", threads, error) ||
-      !dacpo_tool::parseDouble(argc, argv, "-c", c, error) ||
-      !dacpo_tool::parseDouble(argc, argv, "-band", band, error) ||
-      !dacpo_tool::parseDouble(argc, argv, "-two_sheet", two_sheet, error) ||
-      !dacpo_tool::parseDouble(argc, argv, "-weak", weak, error) ||
-      !dacpo_tool::parseDouble(argc, argv, "-time_limit", time_limit, error)) {
-    print_error("Error: %s\n", error.c_str());
-    return false;
-  }
-  if (threads > 4096) {
-    print_error("Error: -threads %llu is too large\n",
-                static_cast<unsigned long long>(threads));
-    return false;
-  }
-  o.params.k = k;
-  o.params.normal_k = normal_k;
-  o.params.num_blocks = blocks;
-  o.params.dipole_orders = orders;
-  o.params.dipole_restarts = restarts;
-  o.params.ring_hops = ring;
-  o.params.seed = seed;
-  o.params.num_threads = static_cast<unsigned>(threads);
-  o.params.dipole_c = c;
-  o.params.dipole_noise_band = band;
-  o.params.dipole_two_sheet = two_sheet;
-  o.params.weak_edge_fraction = weak;
-  o.params.vcr_image_size = vcr_size;
-  o.params.vcr_views = vcr_views;
-  if (find_switch(argc, argv, "-vcr_perspective"))
-    o.params.vcr_perspective = 1;
-  if (find_switch(argc, argv, "-vcr_c1c2"))
-    o.params.vcr_boundary_factor = 0;
-  o.params.solver_time_limit = time_limit;
-  o.params.ipsr_enabled = find_switch(argc, argv, "-no_ipsr") ? 0 : 1;
-  std::string weights;
-  if (parse_argument(argc, argv, "-weights", weights) >= 0) {
-    if (weights == "dipole")
-      o.params.edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
-    else if (weights == "vcr")
-      o.params.edge_weight = DACPO_WEIGHT_VCR;
-    else if (weights == "overlap")
-      o.params.edge_weight = DACPO_WEIGHT_OVERLAP;
-    else {
-      print_error("Error: -weights must be vcr, dipole or overlap, got '%s'\n",
-                  weights.c_str());
+  /* in command-line order: a repeated option keeps its last value */
+  for (int i = 1; i < argc; ++i) {
+    const OptionSpec* spec = findOption(argv[i]);
+    if (spec == nullptr)
+      continue; /* a file (unknown options were rejected before) */
+    std::string value, error;
+    if (spec->arg != nullptr) {
+      if (i + 1 >= argc || argv[i + 1][0] == '\0') {
+        const bool file = std::strncmp(spec->arg, "F.", 2) == 0;
+        print_error("Error: %s needs a %s (%s)\n",
+                    spec->name,
+                    file ? "file name" : "value",
+                    spec->arg);
+        return false;
+      }
+      value = argv[++i];
+    }
+    if (!spec->apply(o, value, error)) {
+      print_error("Error: %s %s\n", spec->name, error.c_str());
       return false;
     }
   }
-  std::string sign;
-  if (parse_argument(argc, argv, "-sign", sign) >= 0) {
-    if (sign == "free")
+  if (!o.sign.empty()) {
+    if (o.sign == "free")
       o.params.sign_policy = DACPO_SIGN_FREE_SPACE;
-    else if (sign == "keep")
+    else if (o.sign == "keep")
       o.params.sign_policy = DACPO_SIGN_KEEP;
     else {
       print_error(
           "Error: -sign must be free or keep (for a viewpoint use -vp x,y,z), got "
           "'%s'\n",
-          sign.c_str());
+          o.sign.c_str());
       return false;
     }
   }
-  if (find_argument(argc, argv, "-vp") >= 0) {
-    double vx = 0.0, vy = 0.0, vz = 0.0;
-    if (parse_3x_arguments(argc, argv, "-vp", vx, vy, vz) < 0 || !std::isfinite(vx) ||
-        !std::isfinite(vy) || !std::isfinite(vz)) {
+  if (!o.viewpoint.empty()) {
+    double v[3];
+    std::stringstream in(o.viewpoint);
+    std::string part;
+    int got = 0;
+    while (got < 4 && std::getline(in, part, ','))
+      got += got < 3 && toDouble(part, v[got]) ? 1 : 4;
+    if (got != 3) {
       print_error("Error: -vp needs three finite numbers x,y,z\n");
       return false;
     }
@@ -788,32 +964,13 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
     o.params.sign_policy = DACPO_SIGN_VIEWPOINT;
-    o.params.viewpoint[0] = vx;
-    o.params.viewpoint[1] = vy;
-    o.params.viewpoint[2] = vz;
+    for (int k = 0; k < 3; ++k)
+      o.params.viewpoint[k] = v[k];
   }
-  if (find_switch(argc, argv, "-separate"))
+  if (o.separate)
     o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
-  if (find_switch(argc, argv, "-bridge"))
+  if (o.bridge)
     o.params.disconnected = DACPO_DISCONNECTED_BRIDGE;
-  o.estimate = find_switch(argc, argv, "-estimate");
-  o.quiet = find_switch(argc, argv, "-q");
-  o.labels = find_switch(argc, argv, "-labels");
-  for (const char* name : {"-edges", "-blocks_colored", "-mesh", "-normals_colored"}) {
-    const int at = find_argument(argc, argv, name);
-    if (at < 0)
-      continue;
-    if (at + 1 >= argc || argv[at + 1][0] == '\0') {
-      print_error("Error: %s needs a file name\n", name);
-      return false;
-    }
-    std::string& target = std::strcmp(name, "-edges") == 0  ? o.edges
-                          : std::strcmp(name, "-mesh") == 0 ? o.mesh
-                          : std::strcmp(name, "-normals_colored") == 0
-                              ? o.normals_colored
-                              : o.blocks_colored;
-    target = argv[at + 1];
-  }
   if (!o.mesh.empty()) {
     if (dacpo_tool::extension(o.mesh) != ".ply") {
       print_error("Error: -mesh needs a .ply file name, got '%s'\n", o.mesh.c_str());
@@ -825,8 +982,6 @@ parseOptions(int argc, char** argv, Options& o)
     }
     o.params.keep_mesh = 1;
   }
-  parse_argument(argc, argv, "-input_dir", o.input_dir);
-  parse_argument(argc, argv, "-output_dir", o.output_dir);
   if (o.input_dir.empty() != o.output_dir.empty()) {
     print_error("Error: -input_dir and -output_dir go together\n");
     return false;
@@ -990,41 +1145,8 @@ main(int argc, char** argv)
   }
   {
     std::string error;
-    if (!dacpo_tool::checkArguments(argc,
-                                    argv,
-                                    {"-estimate",
-                                     "-vcr_perspective",
-                                     "-vcr_c1c2",
-                                     "-no_ipsr",
-                                     "-separate",
-                                     "-bridge",
-                                     "-q",
-                                     "-labels"},
-                                    {"-k",
-                                     "-normal_k",
-                                     "-blocks",
-                                     "-ring",
-                                     "-c",
-                                     "-orders",
-                                     "-restarts",
-                                     "-band",
-                                     "-two_sheet",
-                                     "-weak",
-                                     "-weights",
-                                     "-vcr_size",
-                                     "-vcr_views",
-                                     "-time_limit",
-                                     "-seed",
-                                     "-threads",
-                                     "-sign",
-                                     "-vp",
-                                     "-mesh",
-                                     "-edges",
-                                     "-blocks_colored",
-                                     "-normals_colored",
-                                     "-input_dir",
-                                     "-output_dir"},
-                                    error)) {
+    if (!dacpo_tool::checkArguments(
+            argc, argv, optionNames(false), optionNames(true), error)) {
       print_error("Error: %s\n", error.c_str());
       return 1;
     }
@@ -1032,8 +1154,8 @@ main(int argc, char** argv)
   Options options;
   if (!parseOptions(argc, argv, options))
     return 1;
-  const std::vector<std::string> files = dacpo_tool::fileArguments(
-      argc, argv, {"-edges", "-blocks_colored", "-mesh", "-normals_colored"});
+  const std::vector<std::string> files =
+      dacpo_tool::fileArguments(argc, argv, optionNames(true));
   if (options.input_dir.empty() ? files.size() != 2 : !files.empty()) {
     print_error(options.input_dir.empty()
                     ? "Need one input and one output file (.pcd or .ply), got %zu.\n"
