@@ -1041,53 +1041,29 @@ saveCloud2(const std::string& path,
       error);
 }
 
-/** Strict parse of "-name value" as an unsigned integer; false + message on junk.
- *  Leaves \a value unchanged when the option is absent. */
+/** Strict parse of a non-negative integer (no sign, no trailing junk). */
 inline bool
-parseUnsigned(
-    int argc, char** argv, const char* name, std::uint64_t& value, std::string& error)
+toUnsigned(const std::string& s, std::uint64_t& v)
 {
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], name) != 0)
-      continue;
-    if (i + 1 >= argc) {
-      error = std::string(name) + " needs a value";
-      return false;
-    }
-    const char* s = argv[i + 1];
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long v = std::strtoull(s, &end, 10);
-    if (!*s || *end || errno || s[0] == '-') {
-      error = std::string(name) + " expects a non-negative integer, got '" + s + "'";
-      return false;
-    }
-    value = v;
-  }
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long r = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || *end || errno || s[0] == '-')
+    return false;
+  v = r;
   return true;
 }
 
-/** Strict parse of "-name value" as a finite number. */
+/** Strict parse of a finite number. */
 inline bool
-parseDouble(int argc, char** argv, const char* name, double& value, std::string& error)
+toDouble(const std::string& s, double& v)
 {
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], name) != 0)
-      continue;
-    if (i + 1 >= argc) {
-      error = std::string(name) + " needs a value";
-      return false;
-    }
-    const char* s = argv[i + 1];
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s, &end);
-    if (!*s || *end || errno || !std::isfinite(v)) {
-      error = std::string(name) + " expects a number, got '" + s + "'";
-      return false;
-    }
-    value = v;
-  }
+  char* end = nullptr;
+  errno = 0;
+  const double r = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end || errno || !std::isfinite(r))
+    return false;
+  v = r;
   return true;
 }
 

@@ -111,29 +111,8 @@ struct OptionSpec {
   bool (*apply)(Options&, const std::string&, std::string&);
 };
 
-bool
-toUnsigned(const std::string& s, std::uint64_t& v)
-{
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long r = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || *end || errno || s[0] == '-')
-    return false;
-  v = r;
-  return true;
-}
-
-bool
-toDouble(const std::string& s, double& v)
-{
-  char* end = nullptr;
-  errno = 0;
-  const double r = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end || errno || !std::isfinite(r))
-    return false;
-  v = r;
-  return true;
-}
+using dacpo_tool::toDouble;
+using dacpo_tool::toUnsigned;
 
 /* Setters for fields of dacpo_params, by type. */
 template <typename T, T dacpo_params::*Field>
