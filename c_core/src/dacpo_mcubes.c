@@ -203,6 +203,138 @@ row_edges(dacpo_mcubes* mc,
   return 1;
 }
 
+/* Buffers for a grid of nx x ny x nz values, then each cell's side of the
+ * iso-value (code: 0 = outside the domain, 1 below, 2 above) and which rows
+ * hold any domain cell. Returns 0 when out of memory. */
+static int
+mc_prepare(dacpo_mcubes* mc,
+           size_t nx,
+           size_t ny,
+           size_t nz,
+           const float* val,
+           const uint8_t* dom,
+           float iso)
+{
+  const size_t nxy = nx * ny;
+  const size_t cells = nxy * nz;
+  if (mc->slab_cap < nxy) {
+    int32_t* s = (int32_t*)dacpo_malloc_array(5 * nxy, sizeof(int32_t));
+    if (!s)
+      return 0;
+    free(mc->slab);
+    mc->slab = s;
+    mc->slab_cap = nxy;
+  }
+  if (mc->code_cap < cells + ny * nz) {
+    uint8_t* c = (uint8_t*)dacpo_malloc_array(cells + ny * nz, 1);
+    if (!c)
+      return 0;
+    free(mc->code);
+    mc->code = c;
+    mc->code_cap = cells + ny * nz;
+  }
+  mc->rowany = mc->code + cells;
+  /* One pass: each cell's side of the iso-value (0 = outside the domain),
+   * and which rows hold any domain cell. */
+  for (size_t r = 0; r < ny * nz; ++r) {
+    uint8_t any = 0;
+    const size_t base = r * nx;
+    for (size_t i = 0; i < nx; ++i) {
+      uint8_t c = (!dom || dom[base + i]) ? (uint8_t)(1 + (val[base + i] > iso)) : 0;
+      mc->code[base + i] = c;
+      any |= c;
+    }
+    mc->rowany[r] = any != 0;
+  }
+  return 1;
+}
+
+/* The iso-surface segments on the six faces of one cube (corner signs in
+ * mask, values relative to iso in v): next[e] is the edge the segment that
+ * enters at edge e leaves by (-1: none), segface[e] the face it lies on. */
+static void
+cube_segments(int mask, const float v[8], int next[12], int segface[12])
+{
+  for (int e = 0; e < 12; ++e)
+    next[e] = -1;
+  for (int f = 0; f < 6; ++f) {
+    const int* q = kFace[f];
+    int cross[4], leave[4], nc = 0;
+    for (int t = 0; t < 4; ++t) {
+      int a = q[t], b = q[(t + 1) & 3];
+      int ha = (mask >> a) & 1, hb = (mask >> b) & 1;
+      if (ha != hb) {
+        cross[nc] = edge_of(a, b);
+        leave[nc] = ha;
+        ++nc;
+      }
+    }
+    if (nc == 2) {
+      int from = leave[0] ? cross[0] : cross[1];
+      next[from] = leave[0] ? cross[1] : cross[0];
+      segface[from] = f;
+    }
+    else if (nc == 4) {
+      /* Asymptotic decider: the bilinear interpolant's saddle value
+       * (ac - bd) / (a + c - b - d) (relative to iso) decides whether
+       * the high corners are joined across the face. */
+      double a = v[q[0]], b = v[q[1]], c = v[q[2]], d = v[q[3]];
+      double den = a + c - b - d;
+      int joined = den != 0.0 && (a * c - b * d) / den > 0.0;
+      for (int t = 0; t < 4; ++t)
+        if (leave[t]) {
+          next[cross[t]] = joined ? cross[(t + 1) & 3] : cross[(t + 3) & 3];
+          segface[cross[t]] = f;
+        }
+    }
+  }
+}
+
+/* Triangulates the loops of one cube (vid: the mesh vertex on each of its 12
+ * edges). Returns 0 when out of memory. */
+static int
+cube_triangles(dacpo_mcubes* mc,
+               const int32_t vid[12],
+               const int next[12],
+               const int segface[12])
+{
+  int seen[12] = {0};
+  for (int e0 = 0; e0 < 12; ++e0) {
+    if (next[e0] < 0 || seen[e0])
+      continue;
+    int loop[12], m = 0, faces = 0, twice = 0;
+    for (int e = e0; e >= 0 && !seen[e] && m < 12; e = next[e]) {
+      seen[e] = 1;
+      loop[m++] = e;
+      twice |= faces & (1 << segface[e]);
+      faces |= 1 << segface[e];
+    }
+    if (!twice) {
+      /* A fan: its chords join vertices on no common cube face, so they
+       * run inside this cube and no neighbour can repeat them. */
+      for (int t = 1; t + 1 < m; ++t)
+        if (!emit(mc, vid[loop[0]], vid[loop[t]], vid[loop[t + 1]]))
+          return 0;
+      continue;
+    }
+    /* The loop crosses one face twice (both segments of an ambiguous
+     * face): a fan chord could lie in that face, so fan around the
+     * loop's centroid instead. */
+    if (mc->mesh.num_vertices == mc->vcap && !grow_vertices(mc))
+      return 0;
+    double* cen = mc->mesh.vertices + 3 * mc->mesh.num_vertices;
+    cen[0] = cen[1] = cen[2] = 0.0;
+    for (int t = 0; t < m; ++t)
+      for (int a = 0; a < 3; ++a)
+        cen[a] += mc->mesh.vertices[3 * (size_t)vid[loop[t]] + a] / (double)m;
+    int32_t ci = (int32_t)mc->mesh.num_vertices++;
+    for (int t = 0; t < m; ++t)
+      if (!emit(mc, ci, vid[loop[t]], vid[loop[(t + 1) % m]]))
+        return 0;
+  }
+  return 1;
+}
+
 dacpo_status
 dacpo_mcubes_extract(dacpo_mcubes* mc,
                      const dacpo_grid* g,
@@ -221,37 +353,9 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
   if (nx < 2 || ny < 2 || nz < 2)
     return DACPO_OK;
   const size_t nxy = nx * ny;
-  const size_t cells = nxy * nz;
-  if (mc->slab_cap < nxy) {
-    int32_t* s = (int32_t*)dacpo_malloc_array(5 * nxy, sizeof(int32_t));
-    if (!s)
-      return DACPO_OOM(err);
-    free(mc->slab);
-    mc->slab = s;
-    mc->slab_cap = nxy;
-  }
-  if (mc->code_cap < cells + ny * nz) {
-    uint8_t* c = (uint8_t*)dacpo_malloc_array(cells + ny * nz, 1);
-    if (!c)
-      return DACPO_OOM(err);
-    free(mc->code);
-    mc->code = c;
-    mc->code_cap = cells + ny * nz;
-  }
-  mc->rowany = mc->code + cells;
   const float iso = (float)iso_d;
-  /* One pass: each cell's side of the iso-value (0 = outside the domain),
-   * and which rows hold any domain cell. */
-  for (size_t r = 0; r < ny * nz; ++r) {
-    uint8_t any = 0;
-    const size_t base = r * nx;
-    for (size_t i = 0; i < nx; ++i) {
-      uint8_t c = (!dom || dom[base + i]) ? (uint8_t)(1 + (val[base + i] > iso)) : 0;
-      mc->code[base + i] = c;
-      any |= c;
-    }
-    mc->rowany[r] = any != 0;
-  }
+  if (!mc_prepare(mc, nx, ny, nz, val, dom, iso))
+    return DACPO_OOM(err);
   int32_t* ex[2] = {mc->slab, mc->slab + nxy};
   int32_t* ey[2] = {mc->slab + 2 * nxy, mc->slab + 3 * nxy};
   int32_t* ez = mc->slab + 4 * nxy;
@@ -308,73 +412,9 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
           vid[8 + e] = ez[(i + lo) + nx * (j + hi)]; /* z edges: (x, y) */
         }
         int next[12], segface[12];
-        for (int e = 0; e < 12; ++e)
-          next[e] = -1;
-        for (int f = 0; f < 6; ++f) {
-          const int* q = kFace[f];
-          int cross[4], leave[4], nc = 0;
-          for (int t = 0; t < 4; ++t) {
-            int a = q[t], b = q[(t + 1) & 3];
-            int ha = (mask >> a) & 1, hb = (mask >> b) & 1;
-            if (ha != hb) {
-              cross[nc] = edge_of(a, b);
-              leave[nc] = ha;
-              ++nc;
-            }
-          }
-          if (nc == 2) {
-            int from = leave[0] ? cross[0] : cross[1];
-            next[from] = leave[0] ? cross[1] : cross[0];
-            segface[from] = f;
-          }
-          else if (nc == 4) {
-            /* Asymptotic decider: the bilinear interpolant's saddle value
-             * (ac - bd) / (a + c - b - d) (relative to iso) decides whether
-             * the high corners are joined across the face. */
-            double a = v[q[0]], b = v[q[1]], c = v[q[2]], d = v[q[3]];
-            double den = a + c - b - d;
-            int joined = den != 0.0 && (a * c - b * d) / den > 0.0;
-            for (int t = 0; t < 4; ++t)
-              if (leave[t]) {
-                next[cross[t]] = joined ? cross[(t + 1) & 3] : cross[(t + 3) & 3];
-                segface[cross[t]] = f;
-              }
-          }
-        }
-        int seen[12] = {0};
-        for (int e0 = 0; e0 < 12; ++e0) {
-          if (next[e0] < 0 || seen[e0])
-            continue;
-          int loop[12], m = 0, faces = 0, twice = 0;
-          for (int e = e0; e >= 0 && !seen[e] && m < 12; e = next[e]) {
-            seen[e] = 1;
-            loop[m++] = e;
-            twice |= faces & (1 << segface[e]);
-            faces |= 1 << segface[e];
-          }
-          if (!twice) {
-            /* A fan: its chords join vertices on no common cube face, so they
-             * run inside this cube and no neighbour can repeat them. */
-            for (int t = 1; t + 1 < m; ++t)
-              if (!emit(mc, vid[loop[0]], vid[loop[t]], vid[loop[t + 1]]))
-                return DACPO_OOM(err);
-            continue;
-          }
-          /* The loop crosses one face twice (both segments of an ambiguous
-           * face): a fan chord could lie in that face, so fan around the
-           * loop's centroid instead. */
-          if (mc->mesh.num_vertices == mc->vcap && !grow_vertices(mc))
-            return DACPO_OOM(err);
-          double* cen = mc->mesh.vertices + 3 * mc->mesh.num_vertices;
-          cen[0] = cen[1] = cen[2] = 0.0;
-          for (int t = 0; t < m; ++t)
-            for (int a = 0; a < 3; ++a)
-              cen[a] += mc->mesh.vertices[3 * (size_t)vid[loop[t]] + a] / (double)m;
-          int32_t ci = (int32_t)mc->mesh.num_vertices++;
-          for (int t = 0; t < m; ++t)
-            if (!emit(mc, ci, vid[loop[t]], vid[loop[(t + 1) % m]]))
-              return DACPO_OOM(err);
-        }
+        cube_segments(mask, v, next, segface);
+        if (!cube_triangles(mc, vid, next, segface))
+          return DACPO_OOM(err);
       }
     }
   }
