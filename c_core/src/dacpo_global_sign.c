@@ -219,6 +219,84 @@ density_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
   return vx > 0.0 && vy > 0.0 ? cov / sqrt(vx * vy) : 0.0;
 }
 
+/* Sample spacing: the two largest box extents spread over the sample. */
+static double
+gs_sample_spacing(const dacpo_view_sample* vs)
+{
+  double ext[3];
+  for (int d = 0; d < 3; ++d)
+    ext[d] = vs->hi[d] - vs->lo[d];
+  const double emin = fmin(ext[0], fmin(ext[1], ext[2]));
+  const double area = (ext[0] * ext[1] * ext[2]) / fmax(emin, 1e-300);
+  double spacing = sqrt(fmax(area, 0.0) / (double)vs->m);
+  if (!(spacing > 0.0))
+    spacing = vs->diam > 0.0 ? vs->diam / sqrt((double)vs->m) : 1.0;
+
+  return spacing;
+}
+
+/* Among the `tied` best-scoring candidates: the most visible (z-buffer), then
+ * the farthest; the sampling density of a depth sensor overrides both when it
+ * fits one of them (corr >= GS_DENSITY_FIT). Returns the index, or -1 when
+ * out of memory. */
+static long
+gs_pick(const dacpo_view_sample* vs,
+        const gs_candidate* cand,
+        size_t tied,
+        double spacing,
+        const float* knn_sqd,
+        size_t knn_k,
+        gs_cell* cell)
+{
+  size_t best = 0;
+  double best_vis = -1.0;
+  double* vis = malloc(tied * sizeof(double));
+  double* logd = knn_sqd && knn_k > 0 ? malloc(vs->m * sizeof(double)) : NULL;
+  if (!vis || (knn_sqd && knn_k > 0 && !logd)) {
+    free(logd);
+    free(vis);
+    return -1;
+  }
+  if (logd)
+    for (size_t i = 0; i < vs->m; ++i) {
+      const float* row = knn_sqd + i * vs->stride * knn_k;
+      double far = 0.0;
+      for (size_t j = 0; j < knn_k; ++j) /* absent neighbours are +inf */
+        if (isfinite(row[j]))
+          far = fmax(far, (double)row[j]);
+      logd[i] = -log(fmax(far, 1e-300)); /* -2 log r_k */
+    }
+  for (size_t t = 0; t < tied; ++t) {
+    vis[t] = visible_share(vs, cand[t].v, spacing, cell);
+    if (vis[t] < 0.0) {
+      free(logd);
+      free(vis);
+      return -1;
+    }
+    best_vis = fmax(best_vis, vis[t]);
+  }
+  double best_dist = -1.0;
+  for (size_t t = 0; t < tied; ++t)
+    if (vis[t] >= best_vis - GS_VIS_TIE && cand[t].dist > best_dist) {
+      best_dist = cand[t].dist;
+      best = t;
+    }
+  /* 3. sampling density, when it singles out a sensor */
+  if (logd) {
+    double best_fit = GS_DENSITY_FIT;
+    for (size_t t = 0; t < tied; ++t) {
+      const double fit = density_fit(vs, logd, cand[t].v);
+      if (fit > best_fit) {
+        best_fit = fit;
+        best = t;
+      }
+    }
+  }
+  free(logd);
+  free(vis);
+  return (long)best;
+}
+
 dacpo_status
 dacpo_global_sign(const double* xyz,
                   const double* nrm,
@@ -273,64 +351,13 @@ dacpo_global_sign(const double* xyz,
   while (tied < GS_MAX_TIED && cand[tied].score >= cand[0].score - GS_TIE)
     ++tied;
 
-  /* sample spacing: the two largest box extents spread over the sample */
-  double ext[3];
-  for (int d = 0; d < 3; ++d)
-    ext[d] = vs.hi[d] - vs.lo[d];
-  const double emin = fmin(ext[0], fmin(ext[1], ext[2]));
-  const double area = (ext[0] * ext[1] * ext[2]) / fmax(emin, 1e-300);
-  double spacing = sqrt(fmax(area, 0.0) / (double)vs.m);
-  if (!(spacing > 0.0))
-    spacing = vs.diam > 0.0 ? vs.diam / sqrt((double)vs.m) : 1.0;
-
-  size_t best = 0;
-  double best_vis = -1.0;
-  double* vis = malloc(tied * sizeof(double));
-  double* logd = knn_sqd && knn_k > 0 ? malloc(vs.m * sizeof(double)) : NULL;
-  if (logd)
-    for (size_t i = 0; i < vs.m; ++i) {
-      const float* row = knn_sqd + i * vs.stride * knn_k;
-      double far = 0.0;
-      for (size_t j = 0; j < knn_k; ++j) /* absent neighbours are +inf */
-        if (isfinite(row[j]))
-          far = fmax(far, (double)row[j]);
-      logd[i] = -log(fmax(far, 1e-300)); /* -2 log r_k */
-    }
-  if (!vis || (knn_sqd && knn_k > 0 && !logd)) {
-    free(logd);
+  const double spacing = gs_sample_spacing(&vs);
+  const long best = gs_pick(&vs, cand, tied, spacing, knn_sqd, knn_k, cell);
+  if (best < 0) {
     free(cand);
     free(cell);
     dacpo_view_sample_free(&vs);
     return DACPO_OOM(err);
-  }
-  for (size_t t = 0; t < tied; ++t) {
-    vis[t] = visible_share(&vs, cand[t].v, spacing, cell);
-    if (vis[t] < 0.0) {
-      free(logd);
-      free(vis);
-      free(cand);
-      free(cell);
-      dacpo_view_sample_free(&vs);
-      return DACPO_OOM(err);
-    }
-    best_vis = fmax(best_vis, vis[t]);
-  }
-  double best_dist = -1.0;
-  for (size_t t = 0; t < tied; ++t)
-    if (vis[t] >= best_vis - GS_VIS_TIE && cand[t].dist > best_dist) {
-      best_dist = cand[t].dist;
-      best = t;
-    }
-  /* 3. sampling density, when it singles out a sensor */
-  if (logd) {
-    double best_fit = GS_DENSITY_FIT;
-    for (size_t t = 0; t < tied; ++t) {
-      const double fit = density_fit(&vs, logd, cand[t].v);
-      if (fit > best_fit) {
-        best_fit = fit;
-        best = t;
-      }
-    }
   }
   const gs_candidate* c = &cand[best];
   memcpy(out->viewpoint, c->v, sizeof(out->viewpoint));
@@ -345,8 +372,6 @@ dacpo_global_sign(const double* xyz,
   /* facing: normals towards v; enclosed: away from it */
   out->flip = out->enclosed ? c->facing > 0 : c->facing < 0;
   out->facing = 0.5 + 0.5 * c->score;
-  free(logd);
-  free(vis);
   free(cand);
   free(cell);
   dacpo_view_sample_free(&vs);
