@@ -687,6 +687,86 @@ auto_blocks(size_t n)
     b = 200;
   return b;
 }
+/* Stage 1: blocks, overlap rings and the block graph. */
+static dacpo_status
+segment_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
+  DACPO_TRY(dacpo_segment(&s->cloud,
+                          &s->adj,
+                          s->component,
+                          s->num_components,
+                          target,
+                          s->p.ring_hops,
+                          &s->blocks,
+                          err));
+  DACPO_TRY(dacpo_block_graph_build(&s->blocks, &s->adj, &s->bgraph, err));
+  st->num_blocks = s->blocks.num_blocks;
+  st->num_block_edges = s->bgraph.num_edges;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    size_t nb = s->blocks.own_start[b + 1] - s->blocks.own_start[b] +
+                s->blocks.ring_start[b + 1] - s->blocks.ring_start[b];
+    if (nb > st->peak_block_points)
+      st->peak_block_points = nb;
+  }
+  return DACPO_OK;
+}
+
+/* Stages 2 and 3: one parallel pass over the blocks (independent per block). */
+static dacpo_status
+orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const size_t nb = s->blocks.num_blocks;
+  s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
+  s->point_conf = dacpo_malloc_array(s->cloud.n, sizeof(float));
+  s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
+  s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
+  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
+  if (want_meshes)
+    s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
+  const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
+  if (want_ring)
+    s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
+  if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
+      (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
+    return DACPO_OOM(err);
+  DACPO_TRY(
+      dacpo_parallel_for(nb,
+                         s->p.num_threads,
+                         orient_block,
+                         s,
+                         s->progress,
+                         s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
+                         err));
+  for (size_t b = 0; b < nb; ++b) {
+    st->ipsr_iterations_total += s->ipsr[b].iterations;
+    if (s->ipsr[b].iterations > st->ipsr_iterations_max)
+      st->ipsr_iterations_max = s->ipsr[b].iterations;
+  }
+  return DACPO_OK;
+}
+
+/* Stage 4: the block-graph edge weights of the chosen measure. */
+static dacpo_status
+weigh_edges(run_state* s, dacpo_err* err)
+{
+  /* by the measure asked for: a kept mesh (-mesh) must not switch it to VCR */
+  if (s->p.edge_weight == DACPO_WEIGHT_VCR)
+    DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges,
+                                 s->p.num_threads,
+                                 weigh_edge_vcr,
+                                 s,
+                                 s->progress,
+                                 DACPO_STAGE_EDGE_WEIGHTS,
+                                 err));
+  else if (s->p.edge_weight == DACPO_WEIGHT_OVERLAP)
+    DACPO_TRY(dacpo_block_graph_overlap_weights(
+        &s->bgraph, &s->blocks, s->oriented, s->ring_oriented, err));
+  else
+    DACPO_TRY(dacpo_block_graph_dipole_weights(
+        &s->bgraph, &s->cloud, &s->adj, &s->blocks, s->oriented, s->p.dipole_c, err));
+  return DACPO_OK;
+}
 
 static dacpo_status
 run(dacpo_ctx* ctx,
@@ -728,54 +808,11 @@ run(dacpo_ctx* ctx,
     DACPO_TRY(estimate_normals(s, err));
   STAGE_DONE(DACPO_STAGE_NORMALS);
 
-  size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
-  DACPO_TRY(dacpo_segment(&s->cloud,
-                          &s->adj,
-                          s->component,
-                          s->num_components,
-                          target,
-                          s->p.ring_hops,
-                          &s->blocks,
-                          err));
-  DACPO_TRY(dacpo_block_graph_build(&s->blocks, &s->adj, &s->bgraph, err));
-  st->num_blocks = s->blocks.num_blocks;
-  st->num_block_edges = s->bgraph.num_edges;
-  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
-    size_t nb = s->blocks.own_start[b + 1] - s->blocks.own_start[b] +
-                s->blocks.ring_start[b + 1] - s->blocks.ring_start[b];
-    if (nb > st->peak_block_points)
-      st->peak_block_points = nb;
-  }
+  DACPO_TRY(segment_blocks(s, st, err));
   STAGE_DONE(DACPO_STAGE_SEGMENT);
 
-  /* Stages 2 and 3 share one pass per block (they are independent per block). */
+  DACPO_TRY(orient_blocks(s, st, err));
   const size_t nb = s->blocks.num_blocks;
-  s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
-  s->point_conf = dacpo_malloc_array(s->cloud.n, sizeof(float));
-  s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
-  s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
-  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
-  if (want_meshes)
-    s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
-  const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
-  if (want_ring)
-    s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
-  if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
-      (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
-    return DACPO_OOM(err);
-  DACPO_TRY(
-      dacpo_parallel_for(nb,
-                         s->p.num_threads,
-                         orient_block,
-                         s,
-                         s->progress,
-                         s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
-                         err));
-  for (size_t b = 0; b < nb; ++b) {
-    st->ipsr_iterations_total += s->ipsr[b].iterations;
-    if (s->ipsr[b].iterations > st->ipsr_iterations_max)
-      st->ipsr_iterations_max = s->ipsr[b].iterations;
-  }
   {
     /* Stages 2 and 3 ran in one parallel pass: split its wall time in
      * proportion to the summed per-block times of each stage. */
@@ -790,20 +827,7 @@ run(dacpo_ctx* ctx,
     t = now;
   }
 
-  if (want_meshes)
-    DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges,
-                                 s->p.num_threads,
-                                 weigh_edge_vcr,
-                                 s,
-                                 s->progress,
-                                 DACPO_STAGE_EDGE_WEIGHTS,
-                                 err));
-  else if (want_ring)
-    DACPO_TRY(dacpo_block_graph_overlap_weights(
-        &s->bgraph, &s->blocks, s->oriented, s->ring_oriented, err));
-  else
-    DACPO_TRY(dacpo_block_graph_dipole_weights(
-        &s->bgraph, &s->cloud, &s->adj, &s->blocks, s->oriented, s->p.dipole_c, err));
+  DACPO_TRY(weigh_edges(s, err));
   STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
 
   DACPO_TRY(solve_flips(s, st, err));

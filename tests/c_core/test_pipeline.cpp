@@ -737,3 +737,29 @@ TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
   ASSERT_EQ(r2.status, DACPO_OK);
   EXPECT_EQ(dacpo_ctx_mesh(ctx.get(), nullptr, nullptr, nullptr), 0u);
 }
+
+// Keeping the mesh must not change the edge measure the caller asked for: with
+// keep_mesh the blocks have meshes, which once made every measure VCR.
+TEST(DacpoPipeline, KeepingTheMeshKeepsTheEdgeWeightMeasure)
+{
+  Scene sc;
+  generate(DACPO_SCENE_BOX_OPEN, 8000, 3, &sc);
+  for (dacpo_edge_weight w : {DACPO_WEIGHT_DIPOLE_BOUNDARY, DACPO_WEIGHT_OVERLAP}) {
+    std::vector<std::vector<double>> alpha(2);
+    for (int keep = 0; keep < 2; ++keep) {
+      dacpo_params p = defaults();
+      p.edge_weight = w;
+      p.keep_mesh = keep;
+      auto ctx = makeCtx();
+      Result r = orient(ctx.get(), p, sc.s.xyz, scrambled(sc, 7), sc.s.n);
+      ASSERT_EQ(r.status, DACPO_OK) << r.error;
+      const dacpo_edge_info* e = dacpo_ctx_edges(ctx.get());
+      ASSERT_GT(r.stats.num_block_edges, 0u);
+      for (size_t k = 0; k < r.stats.num_block_edges; ++k)
+        alpha[keep].push_back(e[k].alpha);
+      if (keep)
+        EXPECT_GT(dacpo_ctx_mesh(ctx.get(), nullptr, nullptr, nullptr), 0u);
+    }
+    EXPECT_EQ(alpha[0], alpha[1]) << "edge weight " << static_cast<int>(w);
+  }
+}
