@@ -735,6 +735,27 @@ private:
   void
   fail(PointCloudOut& output, dacpo_status status, const std::string& message);
 
+  /** \brief The usable points (finite, with a usable axis when normals are given),
+   *  packed for the C core, and where each one came from / goes. */
+  struct Packed {
+    std::vector<pcl::index_t> local_to_cloud;
+    std::vector<std::size_t> local_to_out;
+    std::vector<float> xyz, nrm, given_curvature;
+  };
+  /** \brief Rejects the set-ups DACPO does not support (false: output failed). */
+  bool
+  checkSetup(PointCloudOut& output);
+  /** \brief Copies every input point to output (normals NaN) and packs the usable
+   *  ones; output.is_dense tells whether all were. */
+  void
+  packPoints(PointCloudOut& output, Packed& packed) const;
+  /** \brief Normals, curvature, labels, confidence, flips, edges and mesh of a run. */
+  void
+  copyResults(PointCloudOut& output, const dacpo_ctx* ctx, const Packed& packed);
+  /** \brief Warnings about disconnected parts and a solver time-out. */
+  void
+  warnAboutRun(const dacpo_params& params) const;
+
   dacpo_params params_;
   bool use_sensor_origin_ = false;
   ProgressCallback progress_;

@@ -242,48 +242,47 @@ DACPONormalOrientation<PointInT, PointOutT>::initCompute()
 }
 
 template <typename PointInT, typename PointOutT>
-void
-DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& output)
+bool
+DACPONormalOrientation<PointInT, PointOutT>::checkSetup(PointCloudOut& output)
 {
-  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
-  last_status_ = DACPO_OK;
-  last_error_.clear();
-  std::memset(&stats_, 0, sizeof(stats_));
-  component_labels_.clear();
-  point_confidence_.clear();
-  block_labels_.clear();
-  block_flips_.clear();
-  edges_.clear();
-  mesh_vertices_.clear();
-  mesh_triangles_.clear();
-
   if (k_ <= 0 || search_radius_ != 0.0) {
     fail(output,
          DACPO_ERR_INVALID_ARGUMENT,
          "DACPO needs a k-NN graph: set k with setKSearch() (radius search is not "
          "supported)");
-    return;
+    return false;
   }
   if (!fake_surface_ && surface_ != input_) {
     fail(output,
          DACPO_ERR_INVALID_ARGUMENT,
          "a search surface other than the input cloud is not supported");
-    return;
+    return false;
   }
   if (normals_holder_ && normals_size_ != input_->size()) {
     fail(output,
          DACPO_ERR_INVALID_ARGUMENT,
          "the input normals have " + std::to_string(normals_size_) +
              " points but the input cloud has " + std::to_string(input_->size()));
-    return;
+    return false;
   }
 
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::packPoints(PointCloudOut& output,
+                                                        Packed& packed) const
+{
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   /* Pack the usable points: finite coordinates and, when given, a finite
    * non-zero axis. Everything else gets NaN and makes the output not dense. */
   const std::size_t n_out = indices_->size();
-  std::vector<pcl::index_t> local_to_cloud;
-  std::vector<std::size_t> local_to_out;
-  std::vector<float> xyz, nrm, given_curvature;
+  std::vector<pcl::index_t>& local_to_cloud = packed.local_to_cloud;
+  std::vector<std::size_t>& local_to_out = packed.local_to_out;
+  std::vector<float>& xyz = packed.xyz;
+  std::vector<float>& nrm = packed.nrm;
+  std::vector<float>& given_curvature = packed.given_curvature;
   local_to_cloud.reserve(n_out);
   local_to_out.reserve(n_out);
   xyz.reserve(3 * n_out);
@@ -317,6 +316,123 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
       given_curvature.push_back(curv);
   }
   output.is_dense = (skipped == 0);
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::copyResults(PointCloudOut& output,
+                                                         const dacpo_ctx* ctx,
+                                                         const Packed& packed)
+{
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::size_t n_out = indices_->size();
+  const std::size_t m = packed.local_to_cloud.size();
+  const std::vector<std::size_t>& local_to_out = packed.local_to_out;
+  const std::vector<float>& nrm = packed.nrm;
+  const std::vector<float>& given_curvature = packed.given_curvature;
+  const float* curvature = dacpo_ctx_point_curvature(ctx);
+  const std::int32_t* components = dacpo_ctx_point_components(ctx);
+  const std::int32_t* blocks = dacpo_ctx_point_blocks(ctx);
+  const float* confidence = dacpo_ctx_point_confidence(ctx);
+  component_labels_.assign(n_out, -1);
+  point_confidence_.assign(n_out, nan);
+  block_labels_.assign(n_out, -1);
+  for (std::size_t j = 0; j < m; ++j) {
+    PointOutT& o = output[local_to_out[j]];
+    o.normal_x = nrm[3 * j];
+    o.normal_y = nrm[3 * j + 1];
+    o.normal_z = nrm[3 * j + 2];
+    if constexpr (pcl::traits::has_curvature_v<PointOutT>) {
+      if (!given_curvature.empty())
+        o.curvature = given_curvature[j];
+      else
+        o.curvature = curvature ? curvature[j] : 0.0f;
+    }
+    if (components)
+      component_labels_[local_to_out[j]] = components[j];
+    if (blocks)
+      block_labels_[local_to_out[j]] = blocks[j];
+    if (confidence)
+      point_confidence_[local_to_out[j]] = confidence[j];
+  }
+  if (const std::uint8_t* flips = dacpo_ctx_block_flips(ctx))
+    block_flips_.assign(flips, flips + stats_.num_blocks);
+  if (const dacpo_edge_info* edges = dacpo_ctx_edges(ctx))
+    edges_.assign(edges, edges + stats_.num_block_edges);
+  {
+    const float* mv = nullptr;
+    const std::int32_t* mt = nullptr;
+    std::size_t nv = 0;
+    const std::size_t nt = dacpo_ctx_mesh(ctx, &mv, &nv, &mt);
+    if (nt > 0) {
+      mesh_vertices_.assign(mv, mv + 3 * nv);
+      mesh_triangles_.assign(mt, mt + 3 * nt);
+    }
+  }
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::warnAboutRun(
+    const dacpo_params& params) const
+{
+  if (stats_.num_components > 1 && stats_.bridges_added > 0)
+    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
+             "components; %zu bridge edges (longest %g) joined them and the cloud was "
+             "oriented as one.\n",
+             getClassName().c_str(),
+             stats_.num_components,
+             stats_.bridges_added,
+             stats_.longest_bridge);
+  else if (stats_.num_components > 1 && stats_.num_parts > 0)
+    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
+             "components (largest %zu points); the sign of %zu of %zu parts was set by "
+             "the viewpoint they imply (%.0f%% of the points face it), the rest keep "
+             "an undefined sign.\n",
+             getClassName().c_str(),
+             stats_.num_components,
+             stats_.largest_component,
+             stats_.parts_related,
+             stats_.num_parts > 0 ? stats_.num_parts - 1 : 0,
+             100.0 * stats_.view_score);
+  else if (stats_.num_components > 1)
+    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
+             "components (largest %zu points); each is oriented on its own, their "
+             "relative sign is undefined.\n",
+             getClassName().c_str(),
+             stats_.num_components,
+             stats_.largest_component);
+  if (!stats_.solver_optimal && stats_.num_block_edges > 0)
+    PCL_WARN("[pcl::%s::computeFeature] the 0-1 program hit its time limit (%g s); "
+             "the best answer found is used, not proven optimal.\n",
+             getClassName().c_str(),
+             params.solver_time_limit);
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& output)
+{
+  last_status_ = DACPO_OK;
+  last_error_.clear();
+  std::memset(&stats_, 0, sizeof(stats_));
+  component_labels_.clear();
+  point_confidence_.clear();
+  block_labels_.clear();
+  block_flips_.clear();
+  edges_.clear();
+  mesh_vertices_.clear();
+  mesh_triangles_.clear();
+
+  if (!checkSetup(output))
+    return;
+
+  const std::size_t n_out = indices_->size();
+  Packed packed;
+  packPoints(output, packed);
+  std::vector<pcl::index_t>& local_to_cloud = packed.local_to_cloud;
+  std::vector<float>& xyz = packed.xyz;
+  std::vector<float>& nrm = packed.nrm;
   const std::size_t m = local_to_cloud.size();
   if (m == 0) {
     fail(output,
@@ -395,77 +511,8 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
     return;
   }
 
-  const float* curvature = dacpo_ctx_point_curvature(ctx.get());
-  const std::int32_t* components = dacpo_ctx_point_components(ctx.get());
-  const std::int32_t* blocks = dacpo_ctx_point_blocks(ctx.get());
-  const float* confidence = dacpo_ctx_point_confidence(ctx.get());
-  component_labels_.assign(n_out, -1);
-  point_confidence_.assign(n_out, nan);
-  block_labels_.assign(n_out, -1);
-  for (std::size_t j = 0; j < m; ++j) {
-    PointOutT& o = output[local_to_out[j]];
-    o.normal_x = nrm[3 * j];
-    o.normal_y = nrm[3 * j + 1];
-    o.normal_z = nrm[3 * j + 2];
-    if constexpr (pcl::traits::has_curvature_v<PointOutT>) {
-      if (!given_curvature.empty())
-        o.curvature = given_curvature[j];
-      else
-        o.curvature = curvature ? curvature[j] : 0.0f;
-    }
-    if (components)
-      component_labels_[local_to_out[j]] = components[j];
-    if (blocks)
-      block_labels_[local_to_out[j]] = blocks[j];
-    if (confidence)
-      point_confidence_[local_to_out[j]] = confidence[j];
-  }
-  if (const std::uint8_t* flips = dacpo_ctx_block_flips(ctx.get()))
-    block_flips_.assign(flips, flips + stats_.num_blocks);
-  if (const dacpo_edge_info* edges = dacpo_ctx_edges(ctx.get()))
-    edges_.assign(edges, edges + stats_.num_block_edges);
-  {
-    const float* mv = nullptr;
-    const std::int32_t* mt = nullptr;
-    std::size_t nv = 0;
-    const std::size_t nt = dacpo_ctx_mesh(ctx.get(), &mv, &nv, &mt);
-    if (nt > 0) {
-      mesh_vertices_.assign(mv, mv + 3 * nv);
-      mesh_triangles_.assign(mt, mt + 3 * nt);
-    }
-  }
-
-  if (stats_.num_components > 1 && stats_.bridges_added > 0)
-    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
-             "components; %zu bridge edges (longest %g) joined them and the cloud was "
-             "oriented as one.\n",
-             getClassName().c_str(),
-             stats_.num_components,
-             stats_.bridges_added,
-             stats_.longest_bridge);
-  else if (stats_.num_components > 1 && stats_.num_parts > 0)
-    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
-             "components (largest %zu points); the sign of %zu of %zu parts was set by "
-             "the viewpoint they imply (%.0f%% of the points face it), the rest keep "
-             "an undefined sign.\n",
-             getClassName().c_str(),
-             stats_.num_components,
-             stats_.largest_component,
-             stats_.parts_related,
-             stats_.num_parts > 0 ? stats_.num_parts - 1 : 0,
-             100.0 * stats_.view_score);
-  else if (stats_.num_components > 1)
-    PCL_WARN("[pcl::%s::computeFeature] the neighbour graph has %zu connected "
-             "components (largest %zu points); each is oriented on its own, their "
-             "relative sign is undefined.\n",
-             getClassName().c_str(),
-             stats_.num_components,
-             stats_.largest_component);
-  if (!stats_.solver_optimal && stats_.num_block_edges > 0)
-    PCL_WARN("[pcl::%s::computeFeature] the 0-1 program hit its time limit (%g s); "
-             "the best answer found is used, not proven optimal.\n",
-             getClassName().c_str(),
-             params.solver_time_limit);
+  copyResults(output, ctx.get(), packed);
+  warnAboutRun(params);
 }
 
 } // namespace pcl
