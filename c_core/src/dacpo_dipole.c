@@ -104,6 +104,13 @@ dipole_work_free(dipole_work* wk)
   dacpo_kdtree_free(wk->tree);
 }
 
+/* Signed offset of q from the plane through p with unit normal a. */
+static inline double
+plane_offset(const double p[3], const double a[3], const double q[3])
+{
+  return (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
+}
+
 /* Median over points of the RMS distance of a point's K neighbours from its
  * tangent plane: the block's scale of "flat within noise". */
 static double
@@ -120,8 +127,7 @@ block_noise_scale(const double* xyz,
     double s2 = 0.0;
     for (size_t t = 0; t < K; ++t) {
       const double* q = xyz + 3 * (size_t)nb[i * K + t];
-      const double d =
-          (q[0] - p[0]) * m[0] + (q[1] - p[1]) * m[1] + (q[2] - p[2]) * m[2];
+      const double d = plane_offset(p, m, q);
       s2 += d * d;
     }
     tmp[i] = sqrt(s2 / (double)K);
@@ -184,7 +190,7 @@ two_sheet_scales(const double* xyz,
     const double* a = nrm + 3 * i;
     for (size_t t = 0; t < m; ++t) {
       const double* q = xyz + 3 * (size_t)wk->nb[i * K + t];
-      off[t] = fabs((q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2]);
+      off[t] = fabs(plane_offset(p, a, q));
     }
     ts->noise[i] = dacpo_select_kth(off, m, m / 4);
     double sum = 0.0;
