@@ -123,15 +123,15 @@ ilp_pair_cmp(const void* pa, const void* pb)
   return (x->idx > y->idx) - (x->idx < y->idx);
 }
 
+/* Sorts the non-loop edges by their ends and merges parallel ones into g->ea,
+ * g->eb and g->c; also allocates the remaining per-node and adjacency arrays. */
 static dacpo_status
-ilp_graph_build(size_t n,
-                size_t num_edges,
+ilp_merge_edges(size_t num_edges,
                 const dacpo_ilp_edge* edges,
                 ilp_graph* g,
                 dacpo_err* err)
 {
-  memset(g, 0, sizeof(*g));
-  g->n = n;
+  size_t n = g->n;
   size_t np = 0;
   for (size_t i = 0; i < num_edges; ++i)
     np += edges[i].a != edges[i].b;
@@ -164,7 +164,6 @@ ilp_graph_build(size_t n,
   if (!g->ea || !g->eb || !g->c || !g->adj_start || !g->adj_node || !g->adj_edge ||
       !g->comp) {
     free(pairs);
-    ilp_graph_free(g);
     return DACPO_OOM(err);
   }
   size_t e = 0;
@@ -177,21 +176,23 @@ ilp_graph_build(size_t n,
     g->c[e] += in->w_diff - in->w_same; /* parallel edges add up in Eq. 8 */
   }
   free(pairs);
+  return DACPO_OK;
+}
 
-  /* CSR adjacency. Filling in (a, b) order leaves every list ascending: the
-   * smaller neighbours of v come from edges (x, v), x < v, which sort before the
-   * edges (v, y). The intersection of triangle enumeration relies on it. */
+/* CSR adjacency. Filling in (a, b) order leaves every list ascending: the
+ * smaller neighbours of v come from edges (x, v), x < v, which sort before the
+ * edges (v, y). The intersection of triangle enumeration relies on it.
+ * fill: n + 1 scratch entries. */
+static void
+ilp_fill_adjacency(ilp_graph* g, size_t* fill)
+{
+  size_t n = g->n, m = g->m;
   for (size_t k = 0; k < m; ++k) {
     g->adj_start[g->ea[k] + 1]++;
     g->adj_start[g->eb[k] + 1]++;
   }
   for (size_t v = 0; v < n; ++v)
     g->adj_start[v + 1] += g->adj_start[v];
-  size_t* fill = dacpo_malloc_array(n + 1, sizeof(size_t));
-  if (!fill) {
-    ilp_graph_free(g);
-    return DACPO_OOM(err);
-  }
   memcpy(fill, g->adj_start, (n + 1) * sizeof(size_t));
   for (size_t k = 0; k < m; ++k) {
     int32_t a = g->ea[k], b = g->eb[k];
@@ -200,8 +201,14 @@ ilp_graph_build(size_t n,
     g->adj_node[fill[b]] = a;
     g->adj_edge[fill[b]++] = (int32_t)k;
   }
+}
 
-  /* Components by BFS from the lowest unvisited node (fill reused as queue). */
+/* Components by BFS from the lowest unvisited node; queue: n scratch entries.
+ * Sets g->comp and g->ncomp. */
+static void
+ilp_label_components(ilp_graph* g, size_t* queue)
+{
+  size_t n = g->n;
   for (size_t v = 0; v < n; ++v)
     g->comp[v] = -1;
   size_t ncomp = 0;
@@ -209,22 +216,29 @@ ilp_graph_build(size_t n,
     if (g->comp[s] >= 0)
       continue;
     size_t head = 0, tail = 0;
-    fill[tail++] = s;
+    queue[tail++] = s;
     g->comp[s] = (int32_t)ncomp;
     while (head < tail) {
-      size_t v = fill[head++];
+      size_t v = queue[head++];
       for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
         int32_t u = g->adj_node[q];
         if (g->comp[u] < 0) {
           g->comp[u] = (int32_t)ncomp;
-          fill[tail++] = (size_t)u;
+          queue[tail++] = (size_t)u;
         }
       }
     }
     ++ncomp;
   }
-  free(fill);
   g->ncomp = ncomp;
+}
+
+/* Groups nodes and edges by component. Counting sorts keep them ascending
+ * inside each component. */
+static dacpo_status
+ilp_group_components(ilp_graph* g, dacpo_err* err)
+{
+  size_t n = g->n, m = g->m, ncomp = g->ncomp;
   g->comp_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
   g->comp_nodes = dacpo_malloc_array(n, sizeof(int32_t));
   g->cedge_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
@@ -232,10 +246,8 @@ ilp_graph_build(size_t n,
   size_t* cfill = dacpo_malloc_array(ncomp + 1, sizeof(size_t));
   if (!g->comp_start || !g->comp_nodes || !g->cedge_start || !g->cedges || !cfill) {
     free(cfill);
-    ilp_graph_free(g);
     return DACPO_OOM(err);
   }
-  /* Counting sorts keep nodes and edges ascending inside each component. */
   for (size_t v = 0; v < n; ++v)
     g->comp_start[g->comp[v] + 1]++;
   for (size_t c = 0; c < ncomp; ++c)
@@ -252,6 +264,34 @@ ilp_graph_build(size_t n,
     g->cedges[cfill[g->comp[g->ea[k]]]++] = (int32_t)k;
   free(cfill);
   return DACPO_OK;
+}
+
+static dacpo_status
+ilp_graph_build(size_t n,
+                size_t num_edges,
+                const dacpo_ilp_edge* edges,
+                ilp_graph* g,
+                dacpo_err* err)
+{
+  memset(g, 0, sizeof(*g));
+  g->n = n;
+  dacpo_status st = ilp_merge_edges(num_edges, edges, g, err);
+  if (st != DACPO_OK) {
+    ilp_graph_free(g);
+    return st;
+  }
+  size_t* fill = dacpo_malloc_array(n + 1, sizeof(size_t));
+  if (!fill) {
+    ilp_graph_free(g);
+    return DACPO_OOM(err);
+  }
+  ilp_fill_adjacency(g, fill);
+  ilp_label_components(g, fill); /* the fill pointers are done: reused as queue */
+  free(fill);
+  st = ilp_group_components(g, err);
+  if (st != DACPO_OK)
+    ilp_graph_free(g);
+  return st;
 }
 
 /* sum over a component's edges of c_e y_e (Eq. 8 without its constant) */
@@ -421,36 +461,13 @@ ilp_tree_free(ilp_tree* t)
   free(t->acc);
 }
 
-/* Kruskal on |c_e| (the most confident edges decide the relative flips; with
- * rng, on |c_e| times a uniform random factor, for the restarts), a preorder of
- * the forest, and the LCA of every edge's ends by binary lifting. */
-static dacpo_status
-ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
+/* Kruskal on |c_e| (with rng, on |c_e| times a uniform random factor, for the
+ * restarts): marks the edges of the maximum spanning forest in in_tree. */
+static void
+ilp_spanning_forest(
+    const ilp_graph* g, dacpo_rng* rng, ilp_key* keys, int32_t* uf, uint8_t* in_tree)
 {
   size_t n = g->n, m = g->m;
-  dacpo_status st = DACPO_OK;
-  memset(t, 0, sizeof(*t));
-  t->order = dacpo_malloc_array(n, sizeof(int32_t));
-  t->pos = dacpo_malloc_array(n, sizeof(int32_t));
-  t->size = dacpo_malloc_array(n, sizeof(int32_t));
-  t->parent = dacpo_malloc_array(n, sizeof(int32_t));
-  t->pedge = dacpo_malloc_array(n, sizeof(int32_t));
-  t->depth = dacpo_malloc_array(n, sizeof(int32_t));
-  t->lca = dacpo_malloc_array(m, sizeof(int32_t));
-  t->acc = dacpo_malloc_array(n, sizeof(double));
-  ilp_key* keys = dacpo_malloc_array(m, sizeof(*keys));
-  int32_t* uf = dacpo_malloc_array(n, sizeof(int32_t));
-  uint8_t* in_tree = dacpo_calloc_array(m, 1);
-  int32_t* stack = dacpo_malloc_array(n, sizeof(int32_t));
-  size_t levels = 1;
-  while (levels < 31 && ((size_t)1 << levels) < n)
-    ++levels;
-  int32_t* up = dacpo_malloc_array(n, levels * sizeof(int32_t));
-  if (!t->order || !t->pos || !t->size || !t->parent || !t->pedge || !t->depth ||
-      !t->lca || !t->acc || !keys || !uf || !in_tree || !stack || !up) {
-    st = DACPO_OOM(err);
-    goto done;
-  }
   for (size_t k = 0; k < m; ++k) {
     keys[k].key = fabs(g->c[k]) * (rng ? dacpo_rng_uniform(rng) : 1.0);
     keys[k].e = (int32_t)k;
@@ -465,7 +482,17 @@ ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
     dacpo_uf_union(uf, g->ea[e], g->eb[e]);
     in_tree[e] = 1;
   }
-  /* Iterative DFS preorder from each component's lowest node. */
+}
+
+/* Iterative DFS preorder of the forest from each component's lowest node, with
+ * parents, parent edges, depths and subtree sizes. stack: n scratch entries. */
+static void
+ilp_forest_preorder(const ilp_graph* g,
+                    const uint8_t* in_tree,
+                    int32_t* stack,
+                    ilp_tree* t)
+{
+  size_t n = g->n;
   for (size_t v = 0; v < n; ++v)
     t->pos[v] = -1;
   size_t no = 0;
@@ -500,7 +527,14 @@ ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
     if (t->parent[v] >= 0)
       t->size[t->parent[v]] += t->size[v];
   }
-  /* Binary lifting: up[l * n + v] is the 2^l-th ancestor (roots map to self). */
+}
+
+/* The LCA of every edge's ends by binary lifting: up[l * n + v] (levels * n
+ * scratch entries) is the 2^l-th ancestor (roots map to self). */
+static void
+ilp_edge_lcas(const ilp_graph* g, size_t levels, int32_t* up, ilp_tree* t)
+{
+  size_t n = g->n, m = g->m;
   for (size_t v = 0; v < n; ++v)
     up[v] = t->parent[v] >= 0 ? t->parent[v] : (int32_t)v;
   for (size_t l = 1; l < levels; ++l)
@@ -527,6 +561,41 @@ ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
     }
     t->lca[k] = a;
   }
+}
+
+/* Kruskal on |c_e| (the most confident edges decide the relative flips; with
+ * rng, on |c_e| times a uniform random factor, for the restarts), a preorder of
+ * the forest, and the LCA of every edge's ends by binary lifting. */
+static dacpo_status
+ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
+{
+  size_t n = g->n, m = g->m;
+  dacpo_status st = DACPO_OK;
+  memset(t, 0, sizeof(*t));
+  t->order = dacpo_malloc_array(n, sizeof(int32_t));
+  t->pos = dacpo_malloc_array(n, sizeof(int32_t));
+  t->size = dacpo_malloc_array(n, sizeof(int32_t));
+  t->parent = dacpo_malloc_array(n, sizeof(int32_t));
+  t->pedge = dacpo_malloc_array(n, sizeof(int32_t));
+  t->depth = dacpo_malloc_array(n, sizeof(int32_t));
+  t->lca = dacpo_malloc_array(m, sizeof(int32_t));
+  t->acc = dacpo_malloc_array(n, sizeof(double));
+  ilp_key* keys = dacpo_malloc_array(m, sizeof(*keys));
+  int32_t* uf = dacpo_malloc_array(n, sizeof(int32_t));
+  uint8_t* in_tree = dacpo_calloc_array(m, 1);
+  int32_t* stack = dacpo_malloc_array(n, sizeof(int32_t));
+  size_t levels = 1;
+  while (levels < 31 && ((size_t)1 << levels) < n)
+    ++levels;
+  int32_t* up = dacpo_malloc_array(n, levels * sizeof(int32_t));
+  if (!t->order || !t->pos || !t->size || !t->parent || !t->pedge || !t->depth ||
+      !t->lca || !t->acc || !keys || !uf || !in_tree || !stack || !up) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  ilp_spanning_forest(g, rng, keys, uf, in_tree);
+  ilp_forest_preorder(g, in_tree, stack, t);
+  ilp_edge_lcas(g, levels, up, t);
 done:
   free(keys);
   free(uf);
@@ -856,6 +925,113 @@ ilp_heap_down(int32_t* heap, int32_t* pos, const double* key, size_t size, size_
   pos[v] = (int32_t)i;
 }
 
+/* Dijkstra over the doubled local nodes 2 * loc + parity of component nodes
+ * n0.., from src = (s, 0); stops at dst = (s, 1) or once every distance left is
+ * >= 1 (no violated inequality beyond). y: edge values, local edge order. */
+static void
+ilp_parity_dijkstra(const ilp_graph* g,
+                    size_t n0,
+                    size_t nn,
+                    ilp_lp_ws* w,
+                    const double* y,
+                    int32_t src)
+{
+  int32_t dst = src + 1;
+  for (size_t i = 0; i < 2 * nn; ++i) {
+    w->dist[i] = INFINITY;
+    w->heap_pos[i] = -1;
+  }
+  size_t hs = 0;
+  w->dist[src] = 0.0;
+  w->pred[src] = -1;
+  w->heap[hs++] = src;
+  w->heap_pos[src] = 0;
+  while (hs > 0) {
+    int32_t x = w->heap[0];
+    w->heap_pos[x] = -2; /* settled */
+    w->heap[0] = w->heap[--hs];
+    if (hs > 0) {
+      w->heap_pos[w->heap[0]] = 0;
+      ilp_heap_down(w->heap, w->heap_pos, w->dist, hs, 0);
+    }
+    if (x == dst || w->dist[x] >= 1.0 - ILP_CUT_EPS)
+      break;
+    int32_t v = g->comp_nodes[n0 + (size_t)(x / 2)];
+    int par = x & 1;
+    for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
+      int32_t u = g->adj_node[q];
+      double ye = y[w->ecol[g->adj_edge[q]]];
+      ye = ye < 0.0 ? 0.0 : (ye > 1.0 ? 1.0 : ye);
+      for (int sw = 0; sw < 2; ++sw) {
+        int32_t z = 2 * w->loc[u] + (par ^ sw);
+        if (w->heap_pos[z] == -2)
+          continue;
+        double d = w->dist[x] + (sw ? 1.0 - ye : ye);
+        if (d < w->dist[z]) {
+          w->dist[z] = d;
+          w->pred[z] = (int32_t)(2 * q) + par;
+          if (w->heap_pos[z] < 0) {
+            w->heap[hs] = z;
+            w->heap_pos[z] = (int32_t)hs;
+            ++hs;
+          }
+          ilp_heap_up(w->heap, w->heap_pos, w->dist, (size_t)w->heap_pos[z]);
+        }
+      }
+    }
+  }
+}
+
+/* Walks the shortest path from (s, 1) back to (s, 0) into w->cyc_e (edge + 1,
+ * negated where the parity switches). Sets *len and *nf (switching edges).
+ * Returns 0 as soon as a node repeats: only simple cycles are kept. */
+static int
+ilp_walk_cycle(
+    const ilp_graph* g, size_t n0, ilp_lp_ws* w, int32_t s, size_t* len, size_t* nf)
+{
+  int32_t src = 2 * w->loc[s], dst = src + 1;
+  *len = 0;
+  *nf = 0;
+  int simple = 1;
+  int32_t x = dst;
+  while (x != src && simple) {
+    int32_t pq = w->pred[x];
+    size_t q = (size_t)(pq / 2);
+    int32_t ppar = pq & 1;
+    int32_t e = g->adj_edge[q];
+    /* q is in the predecessor's list: the predecessor is e's other end */
+    int32_t cur = g->comp_nodes[n0 + (size_t)(x / 2)];
+    int32_t owner = g->ea[e] == cur ? g->eb[e] : g->ea[e];
+    if (w->mark[w->loc[owner]] && owner != s)
+      simple = 0;
+    w->mark[w->loc[owner]] = 1;
+    int sw = (x & 1) != ppar;
+    w->cyc_e[(*len)++] = sw ? -(e + 1) : (e + 1);
+    *nf += (size_t)sw;
+    x = 2 * w->loc[owner] + ppar;
+  }
+  /* clear marks along the walked part */
+  for (size_t i = 0; i < *len; ++i) {
+    int32_t e = w->cyc_e[i] > 0 ? w->cyc_e[i] - 1 : -w->cyc_e[i] - 1;
+    w->mark[w->loc[g->ea[e]]] = 0;
+    w->mark[w->loc[g->eb[e]]] = 0;
+  }
+  return simple;
+}
+
+/* Several sources find the same cycle: an order-free key drops repeats. */
+static uint64_t
+ilp_cycle_key(const int32_t* cyc_e, size_t len)
+{
+  uint64_t key = (uint64_t)len * 0x9e3779b97f4a7c15ull;
+  for (size_t i = 0; i < len; ++i) {
+    uint64_t z = (uint64_t)(int64_t)cyc_e[i] * 0xbf58476d1ce4e5b9ull;
+    z ^= z >> 31;
+    key += z * 0x94d049bb133111ebull;
+  }
+  return key;
+}
+
 /* Odd-cycle separation for one component (Barahona & Mahjoub): every cycle C
  * and odd F subset of C give  sum_{F} (1 - y_e) + sum_{C \ F} y_e >= 1.  In the
  * doubled graph, an edge keeps the parity with length y_e and switches it with
@@ -880,88 +1056,15 @@ ilp_separate(const ilp_graph* g,
     if (dacpo_now() >= deadline)
       break;
     int32_t s = g->comp_nodes[si];
-    /* Dijkstra over doubled local nodes 2 * loc + parity. */
-    for (size_t i = 0; i < 2 * nn; ++i) {
-      w->dist[i] = INFINITY;
-      w->heap_pos[i] = -1;
-    }
-    size_t hs = 0;
     int32_t src = 2 * w->loc[s], dst = src + 1;
-    w->dist[src] = 0.0;
-    w->pred[src] = -1;
-    w->heap[hs++] = src;
-    w->heap_pos[src] = 0;
-    while (hs > 0) {
-      int32_t x = w->heap[0];
-      w->heap_pos[x] = -2; /* settled */
-      w->heap[0] = w->heap[--hs];
-      if (hs > 0) {
-        w->heap_pos[w->heap[0]] = 0;
-        ilp_heap_down(w->heap, w->heap_pos, w->dist, hs, 0);
-      }
-      if (x == dst || w->dist[x] >= 1.0 - ILP_CUT_EPS)
-        break;
-      int32_t v = g->comp_nodes[n0 + (size_t)(x / 2)];
-      int par = x & 1;
-      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
-        int32_t u = g->adj_node[q];
-        double ye = y[w->ecol[g->adj_edge[q]]];
-        ye = ye < 0.0 ? 0.0 : (ye > 1.0 ? 1.0 : ye);
-        for (int sw = 0; sw < 2; ++sw) {
-          int32_t z = 2 * w->loc[u] + (par ^ sw);
-          if (w->heap_pos[z] == -2)
-            continue;
-          double d = w->dist[x] + (sw ? 1.0 - ye : ye);
-          if (d < w->dist[z]) {
-            w->dist[z] = d;
-            w->pred[z] = (int32_t)(2 * q) + par;
-            if (w->heap_pos[z] < 0) {
-              w->heap[hs] = z;
-              w->heap_pos[z] = (int32_t)hs;
-              ++hs;
-            }
-            ilp_heap_up(w->heap, w->heap_pos, w->dist, (size_t)w->heap_pos[z]);
-          }
-        }
-      }
-    }
+    ilp_parity_dijkstra(g, n0, nn, w, y, src);
     if (!(w->dist[dst] < 1.0 - ILP_CUT_EPS))
       continue;
-    /* Walk back; keep only simple cycles. */
-    size_t len = 0, nf = 0;
-    int simple = 1;
-    int32_t x = dst;
-    while (x != src && simple) {
-      int32_t pq = w->pred[x];
-      size_t q = (size_t)(pq / 2);
-      int32_t ppar = pq & 1;
-      int32_t e = g->adj_edge[q];
-      /* q is in the predecessor's list: the predecessor is e's other end */
-      int32_t cur = g->comp_nodes[n0 + (size_t)(x / 2)];
-      int32_t owner = g->ea[e] == cur ? g->eb[e] : g->ea[e];
-      if (w->mark[w->loc[owner]] && owner != s)
-        simple = 0;
-      w->mark[w->loc[owner]] = 1;
-      int sw = (x & 1) != ppar;
-      w->cyc_e[len++] = sw ? -(e + 1) : (e + 1);
-      nf += (size_t)sw;
-      x = 2 * w->loc[owner] + ppar;
-    }
-    /* clear marks along the walked part */
-    for (size_t i = 0; i < len; ++i) {
-      int32_t e = w->cyc_e[i] > 0 ? w->cyc_e[i] - 1 : -w->cyc_e[i] - 1;
-      w->mark[w->loc[g->ea[e]]] = 0;
-      w->mark[w->loc[g->eb[e]]] = 0;
-    }
+    size_t len, nf;
+    int simple = ilp_walk_cycle(g, n0, w, s, &len, &nf);
     if (!simple || len < 4 || (nf & 1u) == 0)
       continue;
-    /* Several sources find the same cycle: an order-free key drops repeats. */
-    uint64_t key = (uint64_t)len * 0x9e3779b97f4a7c15ull;
-    for (size_t i = 0; i < len; ++i) {
-      uint64_t z = (uint64_t)(int64_t)w->cyc_e[i] * 0xbf58476d1ce4e5b9ull;
-      z ^= z >> 31;
-      key += z * 0x94d049bb133111ebull;
-    }
+    uint64_t key = ilp_cycle_key(w->cyc_e, len);
     int seen = 0;
     for (long i = 0; i < added && !seen; ++i)
       seen = w->cut_key[i] == key;
@@ -1002,6 +1105,179 @@ typedef struct ilp_comp_out {
   int incumbent_optimal; /* the relaxation's bound equals the incumbent's value */
 } ilp_comp_out;
 
+/* lp_solve's objective: max sum c_e y_e over the component's edges (columns
+ * nc+1..nc+mc), normalized to max |c| = 1. Returns lp_solve's ok. */
+static int
+ilp_lp_objective(const ilp_graph* g, size_t ci, size_t nc, lprec* lp, ilp_lp_ws* w)
+{
+  size_t e0 = g->cedge_start[ci], mc = g->cedge_start[ci + 1] - e0;
+  double cmax = 0.0;
+  for (size_t k = 0; k < mc; ++k)
+    cmax = fmax(cmax, fabs(g->c[g->cedges[e0 + k]]));
+  if (!(cmax > 0.0))
+    cmax = 1.0;
+  for (size_t k = 0; k < mc; ++k) {
+    w->row[k] = g->c[g->cedges[e0 + k]] / cmax;
+    w->col[k] = (int)(nc + 1 + k);
+  }
+  return set_obj_fnex(lp, (int)mc, w->row, w->col);
+}
+
+/* The four XOR rows of every edge of the component. Returns lp_solve's ok. */
+static int
+ilp_lp_xor_rows(const ilp_graph* g,
+                size_t ci,
+                size_t nc,
+                lprec* lp,
+                const ilp_lp_ws* w,
+                size_t* rows)
+{
+  size_t e0 = g->cedge_start[ci], mc = g->cedge_start[ci + 1] - e0;
+  int ok = 1;
+  for (size_t k = 0; k < mc && ok; ++k) {
+    int32_t e = g->cedges[e0 + k];
+    int ye = (int)(nc + 1 + k);
+    ok = ilp_add_xor_rows(lp, ye, 1 + w->loc[g->ea[e]], 1 + w->loc[g->eb[e]], rows);
+  }
+  return ok;
+}
+
+/* Triangles a < b < x: intersect the ascending neighbour lists of a and b
+ * above b, so each 3-cycle is found once, from its lowest edge. Returns 0 if
+ * lp_solve refused a row or the deadline passed (then ab->timed_out is set). */
+static int
+ilp_lp_triangle_rows(const ilp_graph* g,
+                     size_t ci,
+                     size_t nc,
+                     lprec* lp,
+                     const ilp_lp_ws* w,
+                     ilp_abort* ab,
+                     size_t* rows)
+{
+  size_t e0 = g->cedge_start[ci], mc = g->cedge_start[ci + 1] - e0;
+  int ok = 1;
+  for (size_t k = 0; k < mc && ok; ++k) {
+    /* building is not interruptible by lp_solve: watch the clock here */
+    if ((k & 255u) == 0 && dacpo_now() >= ab->deadline) {
+      ab->timed_out = 1;
+      ok = 0;
+      break;
+    }
+    int32_t e = g->cedges[e0 + k];
+    int32_t a = g->ea[e], b = g->eb[e];
+    size_t pa = g->adj_start[a], qa = g->adj_start[a + 1];
+    size_t pb = g->adj_start[b], qb = g->adj_start[b + 1];
+    while (pa < qa && g->adj_node[pa] <= b)
+      ++pa;
+    while (pb < qb && g->adj_node[pb] <= b)
+      ++pb;
+    while (pa < qa && pb < qb && ok) {
+      int32_t xa = g->adj_node[pa], xb = g->adj_node[pb];
+      if (xa < xb)
+        ++pa;
+      else if (xb < xa)
+        ++pb;
+      else {
+        ok = ilp_add_triangle_rows(lp,
+                                   (int)(nc + 1 + k),
+                                   (int)nc + 1 + w->ecol[g->adj_edge[pa]],
+                                   (int)nc + 1 + w->ecol[g->adj_edge[pb]],
+                                   rows);
+        ++pa;
+        ++pb;
+      }
+    }
+  }
+  return ok;
+}
+
+/* Cutting planes on the relaxation while it is fractional: each round adds
+ * the violated odd-cycle inequalities and re-solves (warm-started). An
+ * integral relaxation optimum is optimal for Eq. 8 (returns 1, o holds it); a
+ * relaxation bound the incumbent reaches proves the incumbent optimal
+ * (out->incumbent_optimal). *ok drops to 0 if lp_solve refused a cut. */
+static int
+ilp_cut_rounds(const ilp_graph* g,
+               size_t ci,
+               lprec* lp,
+               ilp_lp_ws* w,
+               ilp_abort* ab,
+               double incumbent,
+               double tol,
+               uint8_t* o,
+               ilp_comp_out* out,
+               dacpo_ilp_result* result,
+               size_t* rows,
+               int* ok)
+{
+  size_t nc = g->comp_start[ci + 1] - g->comp_start[ci];
+  size_t e0 = g->cedge_start[ci], mc = g->cedge_start[ci + 1] - e0;
+  int ncols = (int)(nc + mc);
+  double prev_bound = INFINITY;
+  for (int round = 0; round < ILP_CUT_ROUNDS; ++round) {
+    double remaining = ab->deadline - dacpo_now();
+    if (!(remaining > 0.0))
+      break;
+    set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
+    int ret = solve(lp);
+    if (ab->cancelled || ret != OPTIMAL || !get_variables(lp, w->vars))
+      break;
+    if (ilp_read_flips(g, ci, w->vars, ncols, o))
+      return 1;
+    double bound = 0.0;
+    for (size_t k = 0; k < mc; ++k)
+      bound += g->c[g->cedges[e0 + k]] * w->vars[nc + k];
+    if (incumbent >= bound - tol) {
+      out->incumbent_optimal = 1;
+      break;
+    }
+    if (prev_bound - bound < 1e-6 * (1.0 + fabs(bound)))
+      break; /* tailing off: leave the rest to branch and bound */
+    prev_bound = bound;
+    long cuts = ilp_separate(g, ci, lp, w, (int)nc, rows, 2 * nc + 16, ab->deadline);
+    if (cuts < 0) {
+      *ok = 0;
+      break;
+    }
+    if (cuts == 0)
+      break;
+    result->cuts_added += (size_t)cuts;
+  }
+  return 0;
+}
+
+/* Branch and bound on the strengthened model; on a usable answer o holds it
+ * and out->have / out->proven are set. */
+static void
+ilp_branch_and_bound(const ilp_graph* g,
+                     size_t ci,
+                     lprec* lp,
+                     ilp_lp_ws* w,
+                     const ilp_abort* ab,
+                     int ncols,
+                     uint8_t* o,
+                     ilp_comp_out* out)
+{
+  for (int j = 1; j <= ncols; ++j)
+    set_binary(lp, j, TRUE);
+  set_upbo(lp, 1, 0.0);
+  double remaining = ab->deadline - dacpo_now();
+  set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
+  int ret = solve(lp);
+  if (ab->cancelled)
+    return;
+  /* after an abort or time-out, lp_solve's variables are its best improved
+   * solution, if it found any */
+  int usable = ret == OPTIMAL || ret == SUBOPTIMAL || ret == PRESOLVED ||
+               ((ret == USERABORT || ret == TIMEOUT || ret == FEASFOUND) &&
+                get_solutioncount(lp) > 0);
+  if (usable && get_variables(lp, w->vars)) {
+    ilp_read_flips(g, ci, w->vars, ncols, o);
+    out->have = 1;
+    out->proven = ret == OPTIMAL;
+  }
+}
+
 /* Solves one component with lp_solve; writes its flips into o. incumbent is
  * the heuristic's value of the component (sum of c_e y_e), tol the tolerance
  * of value comparisons. */
@@ -1040,59 +1316,12 @@ ilp_lp_component(const ilp_graph* g,
    * Dantzig pricing measured at least as fast as the default Devex here. */
   set_scaling(lp, SCALE_NONE);
   set_pivoting(lp, PRICER_DANTZIG | PRICE_ADAPTIVE);
-  double cmax = 0.0;
-  for (size_t k = 0; k < mc; ++k)
-    cmax = fmax(cmax, fabs(g->c[g->cedges[e0 + k]]));
-  if (!(cmax > 0.0))
-    cmax = 1.0;
-  int ok = 1;
-  for (size_t k = 0; k < mc; ++k) {
-    w->row[k] = g->c[g->cedges[e0 + k]] / cmax;
-    w->col[k] = (int)(nc + 1 + k);
-  }
-  ok = ok && set_obj_fnex(lp, (int)mc, w->row, w->col);
+  int ok = ilp_lp_objective(g, ci, nc, lp, w);
   set_maxim(lp);
   set_add_rowmode(lp, TRUE); /* after the objective, as lp_solve requires */
   size_t rows = 0;
-  for (size_t k = 0; k < mc && ok; ++k) {
-    int32_t e = g->cedges[e0 + k];
-    int ye = (int)(nc + 1 + k);
-    ok = ilp_add_xor_rows(lp, ye, 1 + w->loc[g->ea[e]], 1 + w->loc[g->eb[e]], &rows);
-  }
-  /* Triangles a < b < x: intersect the ascending neighbour lists of a and b
-   * above b, so each 3-cycle is found once, from its lowest edge. */
-  for (size_t k = 0; k < mc && ok; ++k) {
-    /* building is not interruptible by lp_solve: watch the clock here */
-    if ((k & 255u) == 0 && dacpo_now() >= ab->deadline) {
-      ab->timed_out = 1;
-      ok = 0;
-      break;
-    }
-    int32_t e = g->cedges[e0 + k];
-    int32_t a = g->ea[e], b = g->eb[e];
-    size_t pa = g->adj_start[a], qa = g->adj_start[a + 1];
-    size_t pb = g->adj_start[b], qb = g->adj_start[b + 1];
-    while (pa < qa && g->adj_node[pa] <= b)
-      ++pa;
-    while (pb < qb && g->adj_node[pb] <= b)
-      ++pb;
-    while (pa < qa && pb < qb && ok) {
-      int32_t xa = g->adj_node[pa], xb = g->adj_node[pb];
-      if (xa < xb)
-        ++pa;
-      else if (xb < xa)
-        ++pb;
-      else {
-        ok = ilp_add_triangle_rows(lp,
-                                   (int)(nc + 1 + k),
-                                   (int)nc + 1 + w->ecol[g->adj_edge[pa]],
-                                   (int)nc + 1 + w->ecol[g->adj_edge[pb]],
-                                   &rows);
-        ++pa;
-        ++pb;
-      }
-    }
-  }
+  ok = ok && ilp_lp_xor_rows(g, ci, nc, lp, w, &rows);
+  ok = ok && ilp_lp_triangle_rows(g, ci, nc, lp, w, ab, &rows);
   set_add_rowmode(lp, FALSE);
   ok = ok && set_upbo(lp, 1, 0.0); /* the lowest node is the reference */
   if (!ok) { /* out of time, or lp_solve refused a row: the incumbent stands */
@@ -1102,70 +1331,13 @@ ilp_lp_component(const ilp_graph* g,
   }
   put_abortfunc(lp, ilp_abort_cb, ab);
 
-  /* Cutting planes on the relaxation while it is fractional: each round adds
-   * the violated odd-cycle inequalities and re-solves (warm-started). An
-   * integral relaxation optimum is optimal for Eq. 8; a relaxation bound the
-   * incumbent reaches proves the incumbent optimal. */
-  int ret = NOFEASFOUND;
-  int relaxed_integral = 0;
-  double prev_bound = INFINITY;
-  for (int round = 0; round < ILP_CUT_ROUNDS; ++round) {
-    double remaining = ab->deadline - dacpo_now();
-    if (!(remaining > 0.0))
-      break;
-    set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
-    ret = solve(lp);
-    if (ab->cancelled || ret != OPTIMAL || !get_variables(lp, w->vars))
-      break;
-    if (ilp_read_flips(g, ci, w->vars, ncols, o)) {
-      relaxed_integral = 1;
-      break;
-    }
-    double bound = 0.0;
-    for (size_t k = 0; k < mc; ++k)
-      bound += g->c[g->cedges[e0 + k]] * w->vars[nc + k];
-    if (incumbent >= bound - tol) {
-      out->incumbent_optimal = 1;
-      break;
-    }
-    if (prev_bound - bound < 1e-6 * (1.0 + fabs(bound)))
-      break; /* tailing off: leave the rest to branch and bound */
-    prev_bound = bound;
-    long cuts = ilp_separate(g, ci, lp, w, (int)nc, &rows, 2 * nc + 16, ab->deadline);
-    if (cuts < 0) {
-      ok = 0;
-      break;
-    }
-    if (cuts == 0)
-      break;
-    result->cuts_added += (size_t)cuts;
-  }
-  if (relaxed_integral) {
+  if (ilp_cut_rounds(g, ci, lp, w, ab, incumbent, tol, o, out, result, &rows, &ok)) {
     out->have = 1;
     out->proven = 1;
   }
   else if (ok && !ab->cancelled && !out->incumbent_optimal &&
-           ab->deadline - dacpo_now() > 0.0) {
-    /* Branch and bound on the strengthened model. */
-    for (int j = 1; j <= ncols; ++j)
-      set_binary(lp, j, TRUE);
-    set_upbo(lp, 1, 0.0);
-    double remaining = ab->deadline - dacpo_now();
-    set_timeout(lp, isfinite(remaining) ? (long)ceil(remaining) : 0);
-    ret = solve(lp);
-    if (!ab->cancelled) {
-      /* after an abort or time-out, lp_solve's variables are its best
-       * improved solution, if it found any */
-      int usable = ret == OPTIMAL || ret == SUBOPTIMAL || ret == PRESOLVED ||
-                   ((ret == USERABORT || ret == TIMEOUT || ret == FEASFOUND) &&
-                    get_solutioncount(lp) > 0);
-      if (usable && get_variables(lp, w->vars)) {
-        ilp_read_flips(g, ci, w->vars, ncols, o);
-        out->have = 1;
-        out->proven = ret == OPTIMAL;
-      }
-    }
-  }
+           ab->deadline - dacpo_now() > 0.0)
+    ilp_branch_and_bound(g, ci, lp, w, ab, ncols, o, out);
   result->constraints += rows;
   delete_lp(lp);
   if (ab->cancelled)
@@ -1238,6 +1410,96 @@ ilp_progress(const dacpo_progress* progress, double fraction)
          progress->fn(progress->user, DACPO_STAGE_ILP, fraction) != 0;
 }
 
+/* Allocates the lp_solve workspace for n nodes and m merged edges; returns 0
+ * on allocation failure (what was allocated is left for ilp_ws_free). */
+static int
+ilp_ws_alloc(ilp_lp_ws* w, size_t n, size_t m)
+{
+  memset(w, 0, sizeof(*w));
+  size_t nmax = n + m + 1;
+  w->loc = dacpo_malloc_array(n + 1, sizeof(int32_t));
+  w->ecol = dacpo_malloc_array(m + 1, sizeof(int32_t));
+  w->vars = dacpo_calloc_array(nmax, sizeof(double));
+  w->dist = dacpo_malloc_array(2 * n + 2, sizeof(double));
+  w->pred = dacpo_malloc_array(2 * n + 2, sizeof(int32_t));
+  w->heap = dacpo_malloc_array(2 * n + 2, sizeof(int32_t));
+  w->heap_pos = dacpo_malloc_array(2 * n + 2, sizeof(int32_t));
+  w->mark = dacpo_calloc_array(n + 1, 1);
+  w->cyc_e = dacpo_malloc_array(2 * n + 2, sizeof(int32_t));
+  w->cut_key = dacpo_malloc_array(2 * n + 16, sizeof(uint64_t));
+  w->row = dacpo_malloc_array(nmax + 2 * n, sizeof(double));
+  w->col = dacpo_malloc_array(nmax + 2 * n, sizeof(int));
+  return w->loc && w->ecol && w->vars && w->dist && w->pred && w->heap && w->heap_pos &&
+         w->mark && w->cyc_e && w->cut_key && w->row && w->col;
+}
+
+static void
+ilp_ws_free(ilp_lp_ws* w)
+{
+  free(w->loc);
+  free(w->ecol);
+  free(w->vars);
+  free(w->dist);
+  free(w->pred);
+  free(w->heap);
+  free(w->heap_pos);
+  free(w->mark);
+  free(w->cyc_e);
+  free(w->cut_key);
+  free(w->row);
+  free(w->col);
+}
+
+/* Gives every component the heuristic leaves frustrated to lp_solve and keeps
+ * the better of the two answers in o. */
+static dacpo_status
+ilp_solve_components(const ilp_graph* g,
+                     ilp_lp_ws* w,
+                     ilp_abort* ab,
+                     double tol,
+                     uint8_t* o,
+                     uint8_t* o_lp,
+                     dacpo_ilp_result* result,
+                     dacpo_err* err)
+{
+  for (size_t ci = 0; ci < g->ncomp; ++ci) {
+    size_t nc = g->comp_start[ci + 1] - g->comp_start[ci];
+    size_t mc = g->cedge_start[ci + 1] - g->cedge_start[ci];
+    if (mc + 1 <= nc)
+      continue; /* single node or tree: the spanning-tree propagation is exact */
+    double h = ilp_comp_value(g, ci, o);
+    double ub = 0.0; /* every edge at its preferred value */
+    for (size_t q = g->cedge_start[ci]; q < g->cedge_start[ci + 1]; ++q)
+      ub += g->c[g->cedges[q]] > 0.0 ? g->c[g->cedges[q]] : 0.0;
+    if (h >= ub - tol)
+      continue; /* nothing is frustrated: the incumbent reaches the bound */
+    ab->fraction = (double)g->comp_start[ci] / (double)g->n;
+    if (ilp_progress(ab->progress, ab->fraction))
+      return dacpo_err_set(
+          err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
+    if (!(ab->deadline - dacpo_now() > 0.0)) {
+      result->optimal = 0; /* out of time: the incumbent stands */
+      result->heuristic_wins++;
+      continue;
+    }
+    ilp_comp_out out;
+    DACPO_TRY(ilp_lp_component(g, ci, w, ab, h, tol, o_lp, &out, result, err));
+    if (out.incumbent_optimal)
+      continue;
+    double l = out.have ? ilp_comp_value(g, ci, o_lp) : -INFINITY;
+    if (out.have && l >= h) {
+      for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
+        o[g->comp_nodes[q]] = o_lp[g->comp_nodes[q]];
+    }
+    else
+      result->heuristic_wins++;
+    /* A "proven" optimum that the incumbent beats was a numerical accident. */
+    if (!out.have || !out.proven || h > l + tol)
+      result->optimal = 0;
+  }
+  return DACPO_OK;
+}
+
 dacpo_status
 dacpo_ilp_solve(size_t num_nodes,
                 size_t num_edges,
@@ -1262,22 +1524,7 @@ dacpo_ilp_solve(size_t num_nodes,
   uint8_t* o = dacpo_calloc_array(num_nodes, 1);
   uint8_t* o_lp = dacpo_calloc_array(num_nodes, 1);
   ilp_lp_ws w;
-  memset(&w, 0, sizeof(w));
-  size_t nmax = num_nodes + g.m + 1;
-  w.loc = dacpo_malloc_array(num_nodes + 1, sizeof(int32_t));
-  w.ecol = dacpo_malloc_array(g.m + 1, sizeof(int32_t));
-  w.vars = dacpo_calloc_array(nmax, sizeof(double));
-  w.dist = dacpo_malloc_array(2 * num_nodes + 2, sizeof(double));
-  w.pred = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
-  w.heap = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
-  w.heap_pos = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
-  w.mark = dacpo_calloc_array(num_nodes + 1, 1);
-  w.cyc_e = dacpo_malloc_array(2 * num_nodes + 2, sizeof(int32_t));
-  w.cut_key = dacpo_malloc_array(2 * num_nodes + 16, sizeof(uint64_t));
-  w.row = dacpo_malloc_array(nmax + 2 * num_nodes, sizeof(double));
-  w.col = dacpo_malloc_array(nmax + 2 * num_nodes, sizeof(int));
-  if (!o || !o_lp || !w.loc || !w.ecol || !w.vars || !w.dist || !w.pred || !w.heap ||
-      !w.heap_pos || !w.mark || !w.cyc_e || !w.cut_key || !w.row || !w.col) {
+  if (!ilp_ws_alloc(&w, num_nodes, g.m) || !o || !o_lp) {
     st = DACPO_OOM(err);
     goto done;
   }
@@ -1296,45 +1543,9 @@ dacpo_ilp_solve(size_t num_nodes,
   ab.progress = progress;
   ab.deadline = t0 + time_limit; /* +inf: no limit */
   ab.last_call = -INFINITY;
-  for (size_t ci = 0; ci < g.ncomp; ++ci) {
-    size_t nc = g.comp_start[ci + 1] - g.comp_start[ci];
-    size_t mc = g.cedge_start[ci + 1] - g.cedge_start[ci];
-    if (mc + 1 <= nc)
-      continue; /* single node or tree: the spanning-tree propagation is exact */
-    double h = ilp_comp_value(&g, ci, o);
-    double ub = 0.0; /* every edge at its preferred value */
-    for (size_t q = g.cedge_start[ci]; q < g.cedge_start[ci + 1]; ++q)
-      ub += g.c[g.cedges[q]] > 0.0 ? g.c[g.cedges[q]] : 0.0;
-    if (h >= ub - tol)
-      continue; /* nothing is frustrated: the incumbent reaches the bound */
-    ab.fraction = (double)g.comp_start[ci] / (double)num_nodes;
-    if (ilp_progress(progress, ab.fraction)) {
-      st = dacpo_err_set(
-          err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
-      goto done;
-    }
-    if (!(ab.deadline - dacpo_now() > 0.0)) {
-      result->optimal = 0; /* out of time: the incumbent stands */
-      result->heuristic_wins++;
-      continue;
-    }
-    ilp_comp_out out;
-    st = ilp_lp_component(&g, ci, &w, &ab, h, tol, o_lp, &out, result, err);
-    if (st != DACPO_OK)
-      goto done;
-    if (out.incumbent_optimal)
-      continue;
-    double l = out.have ? ilp_comp_value(&g, ci, o_lp) : -INFINITY;
-    if (out.have && l >= h) {
-      for (size_t q = g.comp_start[ci]; q < g.comp_start[ci + 1]; ++q)
-        o[g.comp_nodes[q]] = o_lp[g.comp_nodes[q]];
-    }
-    else
-      result->heuristic_wins++;
-    /* A "proven" optimum that the incumbent beats was a numerical accident. */
-    if (!out.have || !out.proven || h > l + tol)
-      result->optimal = 0;
-  }
+  st = ilp_solve_components(&g, &w, &ab, tol, o, o_lp, result, err);
+  if (st != DACPO_OK)
+    goto done;
   if (ilp_progress(progress, 1.0)) {
     st = dacpo_err_set(
         err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
@@ -1353,18 +1564,7 @@ done:
   result->seconds = dacpo_now() - t0;
   free(o);
   free(o_lp);
-  free(w.loc);
-  free(w.ecol);
-  free(w.vars);
-  free(w.dist);
-  free(w.pred);
-  free(w.heap);
-  free(w.heap_pos);
-  free(w.mark);
-  free(w.cyc_e);
-  free(w.cut_key);
-  free(w.row);
-  free(w.col);
+  ilp_ws_free(&w);
   ilp_graph_free(&g);
   return st;
 }
