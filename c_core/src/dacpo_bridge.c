@@ -291,34 +291,87 @@ br_radius(const br_round* r, const int32_t* act, size_t na)
   return r2;
 }
 
-static void
-br_search_leaf(br_round* r, const br_node* leaf)
+/* The leaf's active points (a point whose bound exceeds its component's best
+ * cannot improve it) into act, their box into qlo/qhi, and into *uni their
+ * common component, -1 if mixed. Returns how many are active. */
+static size_t
+br_leaf_active(const br_round* r,
+               const br_node* leaf,
+               int32_t* act,
+               double* qlo,
+               double* qhi,
+               int32_t* uni)
 {
-  const br_tree* t = r->t;
   const int32_t* plabel = r->plabel;
-  br_best* best = r->best;
-  int32_t act[BR_LEAF];
   size_t na = 0;
-  /* A point whose bound exceeds its component's best cannot improve it. */
   for (int32_t i = leaf->begin; i < leaf->end; ++i)
-    if (r->lb[i] <= best[plabel[i]].d2)
+    if (r->lb[i] <= r->best[plabel[i]].d2)
       act[na++] = i;
   if (na == 0)
-    return;
-  double qlo[3] = {INFINITY, INFINITY, INFINITY};
-  double qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  int32_t uni = plabel[act[0]];
+    return 0;
+  for (int d = 0; d < 3; ++d) {
+    qlo[d] = INFINITY;
+    qhi[d] = -INFINITY;
+  }
+  *uni = plabel[act[0]];
   for (size_t i = 0; i < na; ++i) {
-    const double* x = t->pts[act[i]].x;
+    const double* x = r->t->pts[act[i]].x;
     for (int d = 0; d < 3; ++d) {
       if (x[d] < qlo[d])
         qlo[d] = x[d];
       if (x[d] > qhi[d])
         qhi[d] = x[d];
     }
-    if (plabel[act[i]] != uni)
-      uni = -1;
+    if (plabel[act[i]] != *uni)
+      *uni = -1;
   }
+  return na;
+}
+
+/* Every cross-component pair between the active points and the points of leaf
+ * nd: offered to both components' bests; qmin[i] tracks the nearest foreign
+ * point of act[i]. Returns 1 if a pair was offered. */
+static int
+br_pair_with_leaf(
+    br_round* r, const int32_t* act, size_t na, const br_node* nd, double* qmin)
+{
+  const br_tree* t = r->t;
+  const int32_t* plabel = r->plabel;
+  br_best* best = r->best;
+  int improved = 0;
+  for (size_t i = 0; i < na; ++i) {
+    int32_t q = act[i], cq = plabel[q];
+    const double* xq = t->pts[q].x;
+    for (int32_t p = nd->begin; p < nd->end; ++p) {
+      int32_t cp = plabel[p];
+      if (cp == cq)
+        continue;
+      const double* xp = t->pts[p].x;
+      double dx = xq[0] - xp[0], dy = xq[1] - xp[1], dz = xq[2] - xp[2];
+      double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 < qmin[i])
+        qmin[i] = d2;
+      if (d2 > best[cq].d2 && d2 > best[cp].d2)
+        continue;
+      int32_t u = t->pts[q].id, v = t->pts[p].id;
+      br_offer(&best[cq], d2, u, v);
+      br_offer(&best[cp], d2, v, u);
+      improved = 1;
+    }
+  }
+  return improved;
+}
+
+static void
+br_search_leaf(br_round* r, const br_node* leaf)
+{
+  const br_tree* t = r->t;
+  int32_t act[BR_LEAF];
+  double qlo[3], qhi[3];
+  int32_t uni;
+  size_t na = br_leaf_active(r, leaf, act, qlo, qhi, &uni);
+  if (na == 0)
+    return;
   double r2 = br_radius(r, act, na);
   /* For the points' bounds: the nearest foreign point seen by each, and the
    * nearest box pruned by distance (uniform same-component boxes hold no
@@ -364,28 +417,7 @@ br_search_leaf(br_round* r, const br_node* leaf)
       }
       continue;
     }
-    int improved = 0;
-    for (size_t i = 0; i < na; ++i) {
-      int32_t q = act[i], cq = plabel[q];
-      const double* xq = t->pts[q].x;
-      for (int32_t p = nd->begin; p < nd->end; ++p) {
-        int32_t cp = plabel[p];
-        if (cp == cq)
-          continue;
-        const double* xp = t->pts[p].x;
-        double dx = xq[0] - xp[0], dy = xq[1] - xp[1], dz = xq[2] - xp[2];
-        double d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 < qmin[i])
-          qmin[i] = d2;
-        if (d2 > best[cq].d2 && d2 > best[cp].d2)
-          continue;
-        int32_t u = t->pts[q].id, v = t->pts[p].id;
-        br_offer(&best[cq], d2, u, v);
-        br_offer(&best[cp], d2, v, u);
-        improved = 1;
-      }
-    }
-    if (improved)
+    if (br_pair_with_leaf(r, act, na, nd, qmin))
       r2 = br_radius(r, act, na);
   }
   /* Every foreign point of q was either paired with q (qmin) or lies in a
@@ -641,6 +673,202 @@ br_check_args(const dacpo_cloud* cloud,
   return DACPO_OK;
 }
 
+/* Start of a Boruvka round: every point's current component (tree order) and
+ * the node labels; bests reset; the current roots into roots. Returns their
+ * number. */
+static size_t
+br_round_start(br_tree* tree,
+               size_t n,
+               const int32_t* component,
+               int32_t* parent,
+               size_t C,
+               int32_t* plabel,
+               br_best* best,
+               int32_t* roots)
+{
+  for (size_t i = 0; i < n; ++i)
+    plabel[i] = dacpo_uf_find(parent, component[tree->pts[i].id]);
+  br_tree_label(tree, plabel);
+  size_t nr = 0;
+  for (size_t c = 0; c < C; ++c) {
+    best[c].d2 = INFINITY;
+    best[c].lo = best[c].hi = best[c].a = best[c].b = INT32_MAX;
+    if (parent[c] == (int32_t)c)
+      roots[nr++] = (int32_t)c;
+  }
+  return nr;
+}
+
+/* Round 1 in tree order (all bounds 0); later rounds most promising first,
+ * so each component's best shrinks early and most leaves are skipped. */
+static void
+br_leaf_order(const br_tree* tree, const double* lb, int round, br_leafkey* order)
+{
+  for (size_t l = 0; l < tree->num_leaves; ++l) {
+    const br_node* nd = &tree->nodes[tree->leaves[l]];
+    double key = INFINITY;
+    for (int32_t i = nd->begin; i < nd->end; ++i)
+      if (lb[i] < key)
+        key = lb[i];
+    order[l].key = round == 0 ? 0.0 : key;
+    order[l].leaf = tree->leaves[l];
+  }
+  if (round > 0)
+    qsort(order, tree->num_leaves, sizeof(br_leafkey), br_leafkey_cmp);
+}
+
+/* Joins every root with the component of its best pair; the tree edges are
+ * appended at edges[*num_tree]. Returns the number of joins. */
+static size_t
+br_join_bests(const int32_t* component,
+              int32_t* parent,
+              const br_best* best,
+              const int32_t* roots,
+              size_t nr,
+              br_edge* edges,
+              size_t* num_tree)
+{
+  size_t merged = 0;
+  for (size_t k = 0; k < nr; ++k) {
+    const br_best* bb = &best[roots[k]];
+    if (bb->a == INT32_MAX)
+      continue;
+    int32_t ra = dacpo_uf_find(parent, component[bb->a]);
+    int32_t rb = dacpo_uf_find(parent, component[bb->b]);
+    if (ra == rb)
+      continue; /* the same edge, chosen from the other side */
+    if (ra < rb)
+      parent[rb] = ra;
+    else
+      parent[ra] = rb;
+    edges[*num_tree].u = bb->lo;
+    edges[*num_tree].v = bb->hi;
+    edges[*num_tree].d2 = bb->d2;
+    ++*num_tree;
+    ++merged;
+  }
+  return merged;
+}
+
+/* Up to `extra` further short cross pairs per tree edge, appended after the
+ * num_tree tree edges; *num_edges counts all. */
+static dacpo_status
+br_add_extra_pairs(const dacpo_cloud* cloud,
+                   const dacpo_adjacency* adj,
+                   const int32_t* component,
+                   size_t extra,
+                   br_extra_scratch* xs,
+                   br_edge* edges,
+                   size_t num_tree,
+                   size_t* num_edges,
+                   dacpo_err* err)
+{
+  xs->cap = 2 * extra + 8;
+  xs->sa = dacpo_malloc_array(xs->cap, sizeof(int32_t));
+  xs->sb = dacpo_malloc_array(xs->cap, sizeof(int32_t));
+  xs->used_a = dacpo_malloc_array(xs->cap, 1);
+  xs->used_b = dacpo_malloc_array(xs->cap, 1);
+  xs->taken = dacpo_malloc_array(xs->cap * xs->cap, 1);
+  xs->cand = dacpo_malloc_array(xs->cap * xs->cap, sizeof(br_cand));
+  if (!xs->sa || !xs->sb || !xs->used_a || !xs->used_b || !xs->taken || !xs->cand)
+    return DACPO_OOM(err);
+  for (size_t e = 0; e < num_tree; ++e) {
+    *num_edges += br_extra_pairs(
+        cloud, adj, component, edges[e].u, edges[e].v, extra, xs, edges + *num_edges);
+  }
+  return DACPO_OK;
+}
+
+/* Pairs join different original components and each pair of components is
+ * joined by at most one tree edge, so repeats cannot occur; removing them
+ * anyway keeps the CSR valid whatever the labels were. Returns the number
+ * kept; *longest2 is the longest squared length. */
+static size_t
+br_sort_unique_edges(br_edge* edges, size_t num_edges, double* longest2)
+{
+  qsort(edges, num_edges, sizeof(br_edge), br_edge_cmp);
+  size_t m = 0;
+  *longest2 = 0.0;
+  for (size_t e = 0; e < num_edges; ++e) {
+    if (m > 0 && edges[m - 1].u == edges[e].u && edges[m - 1].v == edges[e].v)
+      continue;
+    edges[m++] = edges[e];
+    if (edges[e].d2 > *longest2)
+      *longest2 = edges[e].d2;
+  }
+  return m;
+}
+
+/* What the Boruvka rounds work on. */
+typedef struct br_boruvka_ws {
+  br_tree tree;
+  int32_t* parent;   /* union-find over the original components */
+  int32_t* roots;    /* current components at the start of a round */
+  br_best* best;     /* per component */
+  int32_t* plabel;   /* tree position -> current component */
+  double* lb;        /* tree position -> lower bound (squared) */
+  br_leafkey* order; /* leaves in search order */
+} br_boruvka_ws;
+
+static void
+br_boruvka_ws_free(br_boruvka_ws* w)
+{
+  free(w->order);
+  br_tree_free(&w->tree);
+  free(w->parent);
+  free(w->roots);
+  free(w->best);
+  free(w->plabel);
+  free(w->lb);
+}
+
+/* Boruvka rounds over C components: the tree edges land in edges[0 ..
+ * *num_tree). */
+static dacpo_status
+br_boruvka(const dacpo_cloud* cloud,
+           const int32_t* component,
+           size_t C,
+           br_boruvka_ws* w,
+           br_edge* edges,
+           size_t* num_tree,
+           dacpo_err* err)
+{
+  size_t n = cloud->n;
+  w->parent = dacpo_malloc_array(C, sizeof(int32_t));
+  w->roots = dacpo_malloc_array(C, sizeof(int32_t));
+  w->best = dacpo_malloc_array(C, sizeof(br_best));
+  w->plabel = dacpo_malloc_array(n, sizeof(int32_t));
+  w->lb = dacpo_calloc_array(n, sizeof(double));
+  if (!w->parent || !w->roots || !w->best || !w->plabel || !w->lb)
+    return DACPO_OOM(err);
+  DACPO_TRY(br_tree_build(&w->tree, cloud->xyz, n, err));
+  w->order = dacpo_malloc_array(w->tree.num_leaves, sizeof(br_leafkey));
+  if (!w->order)
+    return DACPO_OOM(err);
+  for (size_t c = 0; c < C; ++c)
+    w->parent[c] = (int32_t)c;
+
+  size_t num_roots = C;
+  *num_tree = 0;
+  for (int round = 0; num_roots > 1; ++round) {
+    size_t nr = br_round_start(
+        &w->tree, n, component, w->parent, C, w->plabel, w->best, w->roots);
+    br_leaf_order(&w->tree, w->lb, round, w->order);
+    br_round rd = {&w->tree, w->plabel, w->lb, w->best};
+    for (size_t l = 0; l < w->tree.num_leaves; ++l)
+      br_search_leaf(&rd, &w->tree.nodes[w->order[l].leaf]);
+    size_t merged =
+        br_join_bests(component, w->parent, w->best, w->roots, nr, edges, num_tree);
+    if (merged == 0)
+      return dacpo_err_set(err,
+                           DACPO_ERR_INTERNAL,
+                           "bridge: no progress with %zu components left",
+                           num_roots);
+    num_roots -= merged;
+  }
+  return DACPO_OK;
+}
+
 dacpo_status
 dacpo_bridge_components(const dacpo_cloud* cloud,
                         const dacpo_adjacency* adj,
@@ -664,124 +892,28 @@ dacpo_bridge_components(const dacpo_cloud* cloud,
   if (num_components <= 1)
     return br_copy_adjacency(adj, out, err);
 
-  dacpo_status status = DACPO_OK;
   size_t C = num_components;
-  br_tree tree;
-  memset(&tree, 0, sizeof(tree));
-  int32_t* parent = dacpo_malloc_array(C, sizeof(int32_t));
-  int32_t* roots = dacpo_malloc_array(C, sizeof(int32_t));
-  br_best* best = dacpo_malloc_array(C, sizeof(br_best));
-  int32_t* plabel = dacpo_malloc_array(n, sizeof(int32_t));
-  double* lb = dacpo_calloc_array(n, sizeof(double));
-  br_edge* edges = dacpo_malloc_array(C - 1, (extra + 1) * sizeof(br_edge));
-  br_leafkey* order = NULL;
+  br_boruvka_ws w;
+  memset(&w, 0, sizeof(w));
   br_extra_scratch xs;
   memset(&xs, 0, sizeof(xs));
-  if (!parent || !roots || !best || !plabel || !lb || !edges) {
-    status = DACPO_OOM(err);
-    goto done;
-  }
-  status = br_tree_build(&tree, cloud->xyz, n, err);
+  br_edge* edges = dacpo_malloc_array(C - 1, (extra + 1) * sizeof(br_edge));
+  size_t num_tree = 0;
+  dacpo_status status = edges
+                            ? br_boruvka(cloud, component, C, &w, edges, &num_tree, err)
+                            : DACPO_OOM(err);
   if (status != DACPO_OK)
     goto done;
-  order = dacpo_malloc_array(tree.num_leaves, sizeof(br_leafkey));
-  if (!order) {
-    status = DACPO_OOM(err);
-    goto done;
-  }
-  for (size_t c = 0; c < C; ++c)
-    parent[c] = (int32_t)c;
-
-  /* Boruvka rounds: the tree edges land in edges[0 .. C-1). */
-  size_t num_tree = 0, num_roots = C;
-  for (int round = 0; num_roots > 1; ++round) {
-    for (size_t i = 0; i < n; ++i)
-      plabel[i] = dacpo_uf_find(parent, component[tree.pts[i].id]);
-    br_tree_label(&tree, plabel);
-    size_t nr = 0;
-    for (size_t c = 0; c < C; ++c) {
-      best[c].d2 = INFINITY;
-      best[c].lo = best[c].hi = best[c].a = best[c].b = INT32_MAX;
-      if (parent[c] == (int32_t)c)
-        roots[nr++] = (int32_t)c;
-    }
-    /* Round 1 in tree order (all bounds 0); later rounds most promising first,
-     * so each component's best shrinks early and most leaves are skipped. */
-    for (size_t l = 0; l < tree.num_leaves; ++l) {
-      const br_node* nd = &tree.nodes[tree.leaves[l]];
-      double key = INFINITY;
-      for (int32_t i = nd->begin; i < nd->end; ++i)
-        if (lb[i] < key)
-          key = lb[i];
-      order[l].key = round == 0 ? 0.0 : key;
-      order[l].leaf = tree.leaves[l];
-    }
-    if (round > 0)
-      qsort(order, tree.num_leaves, sizeof(br_leafkey), br_leafkey_cmp);
-    br_round rd = {&tree, plabel, lb, best};
-    for (size_t l = 0; l < tree.num_leaves; ++l)
-      br_search_leaf(&rd, &tree.nodes[order[l].leaf]);
-
-    size_t merged = 0;
-    for (size_t k = 0; k < nr; ++k) {
-      const br_best* bb = &best[roots[k]];
-      if (bb->a == INT32_MAX)
-        continue;
-      int32_t ra = dacpo_uf_find(parent, component[bb->a]);
-      int32_t rb = dacpo_uf_find(parent, component[bb->b]);
-      if (ra == rb)
-        continue; /* the same edge, chosen from the other side */
-      if (ra < rb)
-        parent[rb] = ra;
-      else
-        parent[ra] = rb;
-      edges[num_tree].u = bb->lo;
-      edges[num_tree].v = bb->hi;
-      edges[num_tree].d2 = bb->d2;
-      ++num_tree;
-      ++merged;
-    }
-    if (merged == 0) {
-      status = dacpo_err_set(err,
-                             DACPO_ERR_INTERNAL,
-                             "bridge: no progress with %zu components left",
-                             num_roots);
-      goto done;
-    }
-    num_roots -= merged;
-  }
 
   size_t num_edges = num_tree;
   if (extra > 0) {
-    xs.cap = 2 * extra + 8;
-    xs.sa = dacpo_malloc_array(xs.cap, sizeof(int32_t));
-    xs.sb = dacpo_malloc_array(xs.cap, sizeof(int32_t));
-    xs.used_a = dacpo_malloc_array(xs.cap, 1);
-    xs.used_b = dacpo_malloc_array(xs.cap, 1);
-    xs.taken = dacpo_malloc_array(xs.cap * xs.cap, 1);
-    xs.cand = dacpo_malloc_array(xs.cap * xs.cap, sizeof(br_cand));
-    if (!xs.sa || !xs.sb || !xs.used_a || !xs.used_b || !xs.taken || !xs.cand) {
-      status = DACPO_OOM(err);
+    status = br_add_extra_pairs(
+        cloud, adj, component, extra, &xs, edges, num_tree, &num_edges, err);
+    if (status != DACPO_OK)
       goto done;
-    }
-    for (size_t e = 0; e < num_tree; ++e) {
-      num_edges += br_extra_pairs(
-          cloud, adj, component, edges[e].u, edges[e].v, extra, &xs, edges + num_edges);
-    }
   }
-  /* Pairs join different original components and each pair of components is
-   * joined by at most one tree edge, so repeats cannot occur; removing them
-   * anyway keeps the CSR valid whatever the labels were. */
-  qsort(edges, num_edges, sizeof(br_edge), br_edge_cmp);
-  size_t m = 0;
-  double longest2 = 0.0;
-  for (size_t e = 0; e < num_edges; ++e) {
-    if (m > 0 && edges[m - 1].u == edges[e].u && edges[m - 1].v == edges[e].v)
-      continue;
-    edges[m++] = edges[e];
-    if (edges[e].d2 > longest2)
-      longest2 = edges[e].d2;
-  }
+  double longest2;
+  size_t m = br_sort_unique_edges(edges, num_edges, &longest2);
   status = br_merge_adjacency(adj, edges, m, out, err);
   if (status != DACPO_OK)
     goto done;
@@ -797,13 +929,7 @@ done:
   free(xs.used_b);
   free(xs.taken);
   free(xs.cand);
-  free(order);
-  br_tree_free(&tree);
-  free(parent);
-  free(roots);
-  free(best);
-  free(plabel);
-  free(lb);
+  br_boruvka_ws_free(&w);
   free(edges);
   return status;
 }
