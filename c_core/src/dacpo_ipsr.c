@@ -559,6 +559,146 @@ ipsr_vote(
   }
 }
 
+/* One surface from the current normals: Poisson solve, iso-surface, each
+ * face's nearest samples, and the wings trimmed if trimming (else every face
+ * kept). t[0..2]: the clock before the solve, after it, after the extraction. */
+static dacpo_status
+ipsr_surface(ipsr_work* w,
+             const double* nrm,
+             size_t k,
+             int trimming,
+             double far2,
+             const dacpo_ipsr_params* params,
+             const dacpo_mesh** mesh,
+             double* t,
+             dacpo_ipsr_stats* st,
+             dacpo_err* err)
+{
+  t[0] = dacpo_now();
+  dacpo_poisson_info info;
+  DACPO_TRY(dacpo_poisson_solve(w->ps, nrm, &info, err));
+  st->cg_iterations += info.iterations;
+  t[1] = dacpo_now();
+  DACPO_TRY(dacpo_mcubes_extract(w->mc,
+                                 dacpo_poisson_grid(w->ps),
+                                 dacpo_poisson_values(w->ps),
+                                 dacpo_poisson_domain(w->ps),
+                                 info.iso_value,
+                                 mesh,
+                                 err));
+  t[2] = dacpo_now();
+  if (!ensure_faces(w, (*mesh)->num_triangles, k) ||
+      !ensure_vertices(w, (*mesh)->num_vertices))
+    return DACPO_OOM(err);
+  query_faces(w, *mesh, k);
+  if (trimming)
+    trim_faces(w, *mesh, far2, params->trim_interior);
+  else
+    memset(w->removed, 0, (*mesh)->num_triangles);
+  return DACPO_OK;
+}
+
+/* Timings, face count and peak memory of iteration it (t: its four clock
+ * readings: start, solved, extracted, voted). */
+static void
+ipsr_iteration_stats(const ipsr_work* w,
+                     const dacpo_mesh* mesh,
+                     size_t k,
+                     size_t it,
+                     const double* t,
+                     dacpo_ipsr_stats* st)
+{
+  st->solve_seconds += t[1] - t[0];
+  st->extract_seconds += t[2] - t[1];
+  st->vote_seconds += t[3] - t[2];
+  st->iterations = it + 1;
+  st->faces = mesh->num_triangles;
+  size_t b = work_bytes(w, k);
+  if (b > st->peak_bytes)
+    st->peak_bytes = b;
+}
+
+/* Sizes of one block's iterations, and their last surface. */
+typedef struct ipsr_run {
+  size_t n;     /* samples */
+  size_t k;     /* nearest samples a face votes for */
+  size_t top_m; /* changes averaged by the convergence test */
+  double far2;  /* squared trimming distance */
+  int want_mesh;
+  const dacpo_mesh* mesh; /* the last surface (points into the extractor) */
+  int mesh_trimmed;       /* its wings were trimmed */
+} ipsr_run;
+
+/* The iterations: surface, vote, convergence test. With max_iterations == 0
+ * the body still runs once without updating the normals, to give the mesh
+ * (if wanted). old: 3n scratch. */
+static dacpo_status
+ipsr_iterate(ipsr_work* w,
+             ipsr_run* run,
+             const dacpo_ipsr_params* params,
+             double* nrm,
+             double* old,
+             dacpo_ipsr_stats* st,
+             dacpo_err* err)
+{
+  const size_t n = run->n, k = run->k;
+  int trimming = 0;
+  const size_t iters = params->max_iterations;
+  for (size_t it = 0; it < (iters ? iters : (run->want_mesh ? 1u : 0u)); ++it) {
+    if (it >= params->trim_start)
+      trimming = 1;
+    double t[4];
+    DACPO_TRY(
+        ipsr_surface(w, nrm, k, trimming, run->far2, params, &run->mesh, t, st, err));
+    run->mesh_trimmed = trimming;
+    if (iters == 0)
+      break;
+    ipsr_vote(w, run->mesh, k, nrm, old, n);
+    t[3] = dacpo_now();
+    ipsr_iteration_stats(w, run->mesh, k, it, t, st);
+    double metric = mean_of_largest(w->change, n, run->top_m, w->heap);
+    st->final_change = metric;
+    if (metric < params->convergence) {
+      if (trimming) {
+        st->converged = 1;
+        break;
+      }
+      /* Settled with the wings on: refine the rim once more without them. */
+      trimming = 1;
+    }
+  }
+  return DACPO_OK;
+}
+
+/* The per-sample arrays of the work, and old (the previous normals) and orig
+ * (the input normals); returns 0 if one is missing (all freed by the caller). */
+static int
+ipsr_alloc(ipsr_work* w, size_t n, size_t top_m, double** old, double** orig)
+{
+  w->area = (double*)dacpo_malloc_array(n, sizeof(double));
+  w->acc = (double*)dacpo_malloc_array(3 * n, sizeof(double));
+  w->change = (double*)dacpo_malloc_array(n, sizeof(double));
+  w->heap = (double*)dacpo_malloc_array(top_m, sizeof(double));
+  *old = (double*)dacpo_malloc_array(3 * n, sizeof(double));
+  *orig = (double*)dacpo_malloc_array(3 * n, sizeof(double));
+  return w->area && w->acc && w->change && w->heap && *old && *orig;
+}
+
+/* Peak memory at the end, the output mesh included. */
+static void
+ipsr_final_peak(const ipsr_work* w,
+                size_t k,
+                const dacpo_mesh* mesh_out,
+                dacpo_ipsr_stats* st)
+{
+  size_t b = work_bytes(w, k);
+  if (mesh_out)
+    b += mesh_out->num_vertices * 3 * sizeof(double) +
+         mesh_out->num_triangles * 3 * sizeof(int32_t);
+  if (b > st->peak_bytes)
+    st->peak_bytes = b;
+}
+
 dacpo_status
 dacpo_ipsr_block(const double* xyz,
                  double* nrm,
@@ -580,9 +720,13 @@ dacpo_ipsr_block(const double* xyz,
   if (n < 4)
     return DACPO_OK;
 
-  const size_t k = params->face_k < n ? params->face_k : n;
+  ipsr_run run;
+  memset(&run, 0, sizeof(run));
+  run.n = n;
+  run.k = params->face_k < n ? params->face_k : n;
   const size_t top_m0 = (n + 999) / 1000;
-  const size_t top_m = top_m0 > 10 ? top_m0 : 10;
+  run.top_m = top_m0 > 10 ? top_m0 : 10;
+  run.want_mesh = mesh_out != NULL;
   ipsr_work w;
   memset(&w, 0, sizeof(w));
   dacpo_status status = DACPO_OK;
@@ -590,19 +734,13 @@ dacpo_ipsr_block(const double* xyz,
   double* orig = NULL; /* the input normals, restored on error */
   int saved = 0;
 
-  w.area = (double*)dacpo_malloc_array(n, sizeof(double));
-  w.acc = (double*)dacpo_malloc_array(3 * n, sizeof(double));
-  w.change = (double*)dacpo_malloc_array(n, sizeof(double));
-  w.heap = (double*)dacpo_malloc_array(top_m, sizeof(double));
-  old = (double*)dacpo_malloc_array(3 * n, sizeof(double));
-  orig = (double*)dacpo_malloc_array(3 * n, sizeof(double));
-  if (!w.area || !w.acc || !w.change || !w.heap || !old || !orig) {
+  if (!ipsr_alloc(&w, n, run.top_m, &old, &orig)) {
     status = DACPO_OOM(err);
     goto done;
   }
   memcpy(orig, nrm, 3 * n * sizeof(double));
   saved = 1;
-  w.bytes = n * (11 * sizeof(double)) + top_m * sizeof(double);
+  w.bytes = n * (11 * sizeof(double)) + run.top_m * sizeof(double);
   if ((status = dacpo_kdtree_build(xyz, n, &w.tree, err)) != DACPO_OK)
     goto done;
   double spacing = 0.0;
@@ -611,82 +749,18 @@ dacpo_ipsr_block(const double* xyz,
 
   if ((status = ipsr_setup(&w, xyz, n, spacing, params, st, err)) != DACPO_OK)
     goto done;
-  const dacpo_grid* grid = dacpo_poisson_grid(w.ps);
   const double far = params->trim_spacings * spacing;
-  const double far2 = far * far;
-
-  int trimming = 0;
-  const dacpo_mesh* mesh = NULL;
-  int mesh_trimmed = 0;
-  /* With max_iterations == 0 the loop body still runs once without updating
-   * the normals, to give mesh_out. */
-  const size_t iters = params->max_iterations;
-  for (size_t it = 0; it < (iters ? iters : (mesh_out ? 1u : 0u)); ++it) {
-    if (it >= params->trim_start)
-      trimming = 1;
-    double t0 = dacpo_now();
-    dacpo_poisson_info info;
-    if ((status = dacpo_poisson_solve(w.ps, nrm, &info, err)) != DACPO_OK)
-      goto done;
-    st->cg_iterations += info.iterations;
-    double t1 = dacpo_now();
-    if ((status = dacpo_mcubes_extract(w.mc,
-                                       grid,
-                                       dacpo_poisson_values(w.ps),
-                                       dacpo_poisson_domain(w.ps),
-                                       info.iso_value,
-                                       &mesh,
-                                       err)) != DACPO_OK)
-      goto done;
-    double t2 = dacpo_now();
-    if (!ensure_faces(&w, mesh->num_triangles, k) ||
-        !ensure_vertices(&w, mesh->num_vertices)) {
-      status = DACPO_OOM(err);
-      goto done;
-    }
-    query_faces(&w, mesh, k);
-    if (trimming)
-      trim_faces(&w, mesh, far2, params->trim_interior);
-    else
-      memset(w.removed, 0, mesh->num_triangles);
-    mesh_trimmed = trimming;
-    if (iters == 0)
-      break;
-    ipsr_vote(&w, mesh, k, nrm, old, n);
-    double t3 = dacpo_now();
-    st->solve_seconds += t1 - t0;
-    st->extract_seconds += t2 - t1;
-    st->vote_seconds += t3 - t2;
-    st->iterations = it + 1;
-    st->faces = mesh->num_triangles;
-    size_t b = work_bytes(&w, k);
-    if (b > st->peak_bytes)
-      st->peak_bytes = b;
-    double metric = mean_of_largest(w.change, n, top_m, w.heap);
-    st->final_change = metric;
-    if (metric < params->convergence) {
-      if (trimming) {
-        st->converged = 1;
-        break;
-      }
-      /* Settled with the wings on: refine the rim once more without them. */
-      trimming = 1;
-    }
-  }
-  if (mesh_out && mesh && mesh->num_triangles > 0) {
-    if (!mesh_trimmed)
-      trim_faces(&w, mesh, far2, params->trim_interior);
-    if ((status = build_output(&w, mesh, nrm, n_own, k, mesh_out, err)) != DACPO_OK)
+  run.far2 = far * far;
+  if ((status = ipsr_iterate(&w, &run, params, nrm, old, st, err)) != DACPO_OK)
+    goto done;
+  if (mesh_out && run.mesh && run.mesh->num_triangles > 0) {
+    if (!run.mesh_trimmed)
+      trim_faces(&w, run.mesh, run.far2, params->trim_interior);
+    status = build_output(&w, run.mesh, nrm, n_own, run.k, mesh_out, err);
+    if (status != DACPO_OK)
       goto done;
   }
-  {
-    size_t b = work_bytes(&w, k);
-    if (mesh_out)
-      b += mesh_out->num_vertices * 3 * sizeof(double) +
-           mesh_out->num_triangles * 3 * sizeof(int32_t);
-    if (b > st->peak_bytes)
-      st->peak_bytes = b;
-  }
+  ipsr_final_peak(&w, run.k, mesh_out, st);
 done:
   if (status != DACPO_OK) {
     if (saved)
