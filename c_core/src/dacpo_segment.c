@@ -260,6 +260,71 @@ seg_cmp_i32(const void* a, const void* b)
   return (x > y) - (x < y);
 }
 
+/* The ring of block blk: BFS up to ring_hops hops from its own points into
+ * points of the same component, into queue (sorted). Returns its length. */
+static size_t
+seg_block_ring(const dacpo_adjacency* adj,
+               const int32_t* component,
+               size_t ring_hops,
+               const dacpo_blocks* b,
+               size_t blk,
+               int32_t* stamp,
+               int32_t* queue)
+{
+  const int32_t tag = (int32_t)blk;
+  const int32_t comp = b->component_of_block[blk];
+  const int32_t* own = b->own + b->own_start[blk];
+  const size_t num_own = b->own_start[blk + 1] - b->own_start[blk];
+  for (size_t i = 0; i < num_own; ++i)
+    stamp[own[i]] = tag;
+  size_t qlen = 0;
+  size_t layer_lo = 0, layer_hi = 0; /* queue range of the previous layer */
+  for (size_t hop = 1; hop <= ring_hops; ++hop) {
+    const int32_t* src = hop == 1 ? own : queue + layer_lo;
+    size_t num_src = hop == 1 ? num_own : layer_hi - layer_lo;
+    if (num_src == 0)
+      break;
+    for (size_t i = 0; i < num_src; ++i) {
+      int32_t p = src[i];
+      for (size_t e = adj->start[p]; e < adj->start[p + 1]; ++e) {
+        int32_t q = adj->nbr[e];
+        if (stamp[q] != tag && component[q] == comp) {
+          stamp[q] = tag;
+          queue[qlen++] = q;
+        }
+      }
+    }
+    layer_lo = hop == 1 ? 0 : layer_hi;
+    layer_hi = qlen;
+  }
+  qsort(queue, qlen, sizeof(int32_t), seg_cmp_i32);
+  return qlen;
+}
+
+/* Appends qlen ring points to b->ring (*len used of *cap), doubling the
+ * capacity when needed. Returns 0 if it cannot grow. */
+static int
+seg_append_ring(
+    dacpo_blocks* b, const int32_t* ring, size_t qlen, size_t* cap, size_t* len)
+{
+  if (qlen > *cap - *len) {
+    size_t need = *len + qlen;
+    size_t new_cap = *cap > SIZE_MAX / 2 ? need : *cap * 2;
+    if (new_cap < need)
+      new_cap = need;
+    int32_t* grown = new_cap > SIZE_MAX / sizeof(int32_t)
+                         ? NULL
+                         : (int32_t*)realloc(b->ring, new_cap * sizeof(int32_t));
+    if (grown == NULL)
+      return 0;
+    b->ring = grown;
+    *cap = new_cap;
+  }
+  memcpy(b->ring + *len, ring, qlen * sizeof(int32_t));
+  *len += qlen;
+  return 1;
+}
+
 /* Rings: depth-limited BFS from each block's own points into other blocks of the
  * same component. stamp[p] == b marks p as seen for block b; block ids are
  * distinct, so the array is never cleared. The BFS queue only ever holds ring
@@ -297,50 +362,11 @@ seg_build_rings(const dacpo_adjacency* adj,
     stamp[i] = -1;
 
   for (size_t blk = 0; blk < b->num_blocks; ++blk) {
-    const int32_t tag = (int32_t)blk;
-    const int32_t comp = b->component_of_block[blk];
-    const int32_t* own = b->own + b->own_start[blk];
-    const size_t num_own = b->own_start[blk + 1] - b->own_start[blk];
-    for (size_t i = 0; i < num_own; ++i)
-      stamp[own[i]] = tag;
-    size_t qlen = 0;
-    size_t layer_lo = 0, layer_hi = 0; /* queue range of the previous layer */
-    for (size_t hop = 1; hop <= ring_hops; ++hop) {
-      const int32_t* src = hop == 1 ? own : queue + layer_lo;
-      size_t num_src = hop == 1 ? num_own : layer_hi - layer_lo;
-      if (num_src == 0)
-        break;
-      for (size_t i = 0; i < num_src; ++i) {
-        int32_t p = src[i];
-        for (size_t e = adj->start[p]; e < adj->start[p + 1]; ++e) {
-          int32_t q = adj->nbr[e];
-          if (stamp[q] != tag && component[q] == comp) {
-            stamp[q] = tag;
-            queue[qlen++] = q;
-          }
-        }
-      }
-      layer_lo = hop == 1 ? 0 : layer_hi;
-      layer_hi = qlen;
+    size_t qlen = seg_block_ring(adj, component, ring_hops, b, blk, stamp, queue);
+    if (!seg_append_ring(b, queue, qlen, &cap, &len)) {
+      st = DACPO_OOM(err);
+      goto done;
     }
-    qsort(queue, qlen, sizeof(int32_t), seg_cmp_i32);
-    if (qlen > cap - len) {
-      size_t need = len + qlen;
-      size_t new_cap = cap > SIZE_MAX / 2 ? need : cap * 2;
-      if (new_cap < need)
-        new_cap = need;
-      int32_t* grown = new_cap > SIZE_MAX / sizeof(int32_t)
-                           ? NULL
-                           : (int32_t*)realloc(b->ring, new_cap * sizeof(int32_t));
-      if (grown == NULL) {
-        st = DACPO_OOM(err);
-        goto done;
-      }
-      b->ring = grown;
-      cap = new_cap;
-    }
-    memcpy(b->ring + len, queue, qlen * sizeof(int32_t));
-    len += qlen;
     b->ring_start[blk + 1] = len;
   }
 
@@ -474,6 +500,105 @@ seg_renumber(size_t num_raw,
   return DACPO_OK;
 }
 
+/* Seeds, component by component (the kd split of step 2 and 3); raw_comp gets
+ * the component of each seed's raw block. */
+static dacpo_status
+seg_place_seeds(seg_splitter* sp,
+                const size_t* comp_start,
+                const size_t* nblk,
+                size_t num_components,
+                size_t total,
+                int32_t* raw_comp,
+                dacpo_err* err)
+{
+  dacpo_rng_seed(&sp->rng, 0x5e9d0b10c5ULL, 1);
+  for (size_t c = 0; c < num_components; ++c) {
+    if (nblk[c] == 0)
+      continue;
+    size_t first = sp->num_seeds;
+    seg_split(sp, comp_start[c], comp_start[c + 1], nblk[c]);
+    for (size_t s = first; s < sp->num_seeds; ++s)
+      raw_comp[s] = (int32_t)c;
+  }
+  if (sp->num_seeds != total)
+    return dacpo_err_set(err,
+                         DACPO_ERR_INTERNAL,
+                         "segment: kd split produced %zu seeds, expected %zu",
+                         sp->num_seeds,
+                         total);
+  return DACPO_OK;
+}
+
+/* Grows all blocks at once: the queue starts with every seed in block order.
+ * block_of gets the raw block of every point. Returns the number of raw
+ * blocks. */
+static size_t
+seg_grow_blocks(const dacpo_adjacency* adj,
+                const int32_t* component,
+                const int32_t* seeds,
+                size_t total,
+                int32_t* block_of,
+                int32_t* raw_comp,
+                int32_t* queue)
+{
+  const size_t n = adj->n;
+  for (size_t i = 0; i < n; ++i)
+    block_of[i] = -1;
+  for (size_t s = 0; s < total; ++s) {
+    block_of[seeds[s]] = (int32_t)s;
+    queue[s] = seeds[s];
+  }
+  size_t qlen = seg_grow(adj, component, block_of, queue, 0, total);
+
+  /* A point no seed reached means its labelled component is not connected in
+   * adj. Give each such piece its own block, grown the same way, so every block
+   * stays connected and no point is left unlabelled. */
+  size_t num_raw = total;
+  if (qlen < n) {
+    for (size_t i = 0; i < n; ++i) {
+      if (block_of[i] >= 0)
+        continue;
+      block_of[i] = (int32_t)num_raw;
+      raw_comp[num_raw] = component[i];
+      ++num_raw;
+      size_t head = qlen;
+      queue[qlen++] = (int32_t)i;
+      qlen = seg_grow(adj, component, block_of, queue, head, qlen);
+    }
+  }
+  return num_raw;
+}
+
+/* Dense ids, component by component, seed order inside; empty blocks dropped
+ * (a seed always owns itself, so none is expected). */
+static dacpo_status
+seg_dense_ids(size_t n,
+              size_t num_raw,
+              const int32_t* raw_comp,
+              size_t num_components,
+              dacpo_blocks* res,
+              dacpo_err* err)
+{
+  dacpo_status st = DACPO_OK;
+  size_t* raw_size = (size_t*)dacpo_calloc_array(num_raw, sizeof(size_t));
+  int32_t* remap = (int32_t*)dacpo_malloc_array(num_raw, sizeof(int32_t));
+  if (raw_size == NULL || remap == NULL) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  for (size_t i = 0; i < n; ++i)
+    raw_size[res->block_of[i]]++;
+  st = seg_renumber(num_raw, raw_size, raw_comp, num_components, res, remap, err);
+  if (st != DACPO_OK)
+    goto done;
+  for (size_t i = 0; i < n; ++i)
+    res->block_of[i] = remap[res->block_of[i]];
+done:
+  free(raw_size);
+  free(remap);
+  return st;
+}
+
 dacpo_status
 dacpo_segment(const dacpo_cloud* cloud,
               const dacpo_adjacency* adj,
@@ -497,17 +622,13 @@ dacpo_segment(const dacpo_cloud* cloud,
   dacpo_status st = DACPO_OK;
   dacpo_blocks res;
   memset(&res, 0, sizeof(res));
-  size_t* comp_start = NULL; /* num_components + 1 */
-  size_t* nblk = NULL;       /* blocks wanted per component */
   seg_splitter sp;
   memset(&sp, 0, sizeof(sp));
   int32_t* raw_comp = NULL; /* component of each raw (pre-renumbering) block */
   int32_t* queue = NULL;
-  size_t* raw_size = NULL;
-  int32_t* remap = NULL;
-
-  comp_start = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
-  nblk = (size_t*)dacpo_calloc_array(num_components, sizeof(size_t));
+  /* points of each component (see seg_group_by_component), blocks wanted */
+  size_t* comp_start = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
+  size_t* nblk = (size_t*)dacpo_calloc_array(num_components, sizeof(size_t));
   sp.idx = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
   if (comp_start == NULL || nblk == NULL || sp.idx == NULL) {
     st = DACPO_OOM(err);
@@ -521,8 +642,8 @@ dacpo_segment(const dacpo_cloud* cloud,
   const size_t total =
       seg_blocks_per_component(comp_start, num_components, n, target_blocks, nblk);
 
-  /* Seeds, component by component. Unreached points (see below) may add at most
-   * n - total further blocks, so n slots are enough for all raw blocks. */
+  /* Unreached points (see seg_grow_blocks) may add at most n - total further
+   * blocks, so n slots are enough for all raw blocks. */
   sp.xyz = cloud->xyz;
   sp.seeds = (int32_t*)dacpo_malloc_array(total, sizeof(int32_t));
   raw_comp = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
@@ -532,66 +653,13 @@ dacpo_segment(const dacpo_cloud* cloud,
     st = DACPO_OOM(err);
     goto fail;
   }
-  dacpo_rng_seed(&sp.rng, 0x5e9d0b10c5ULL, 1);
-  for (size_t c = 0; c < num_components; ++c) {
-    if (nblk[c] == 0)
-      continue;
-    size_t first = sp.num_seeds;
-    seg_split(&sp, comp_start[c], comp_start[c + 1], nblk[c]);
-    for (size_t s = first; s < sp.num_seeds; ++s)
-      raw_comp[s] = (int32_t)c;
-  }
-  if (sp.num_seeds != total) {
-    st = dacpo_err_set(err,
-                       DACPO_ERR_INTERNAL,
-                       "segment: kd split produced %zu seeds, expected %zu",
-                       sp.num_seeds,
-                       total);
+  st = seg_place_seeds(&sp, comp_start, nblk, num_components, total, raw_comp, err);
+  if (st != DACPO_OK)
     goto fail;
-  }
-
-  /* Grow all blocks at once: the queue starts with every seed in block order. */
-  for (size_t i = 0; i < n; ++i)
-    res.block_of[i] = -1;
-  for (size_t s = 0; s < total; ++s) {
-    res.block_of[sp.seeds[s]] = (int32_t)s;
-    queue[s] = sp.seeds[s];
-  }
-  size_t qlen = seg_grow(adj, component, res.block_of, queue, 0, total);
-
-  /* A point no seed reached means its labelled component is not connected in
-   * adj. Give each such piece its own block, grown the same way, so every block
-   * stays connected and no point is left unlabelled. */
-  size_t num_raw = total;
-  if (qlen < n) {
-    for (size_t i = 0; i < n; ++i) {
-      if (res.block_of[i] >= 0)
-        continue;
-      res.block_of[i] = (int32_t)num_raw;
-      raw_comp[num_raw] = component[i];
-      ++num_raw;
-      size_t head = qlen;
-      queue[qlen++] = (int32_t)i;
-      qlen = seg_grow(adj, component, res.block_of, queue, head, qlen);
-    }
-  }
-
-  /* Dense ids, component by component, seed order inside; empty blocks dropped
-   * (a seed always owns itself, so none is expected). */
-  raw_size = (size_t*)dacpo_calloc_array(num_raw, sizeof(size_t));
-  remap = (int32_t*)dacpo_malloc_array(num_raw, sizeof(int32_t));
-  if (raw_size == NULL || remap == NULL) {
-    st = DACPO_OOM(err);
+  size_t num_raw =
+      seg_grow_blocks(adj, component, sp.seeds, total, res.block_of, raw_comp, queue);
+  if ((st = seg_dense_ids(n, num_raw, raw_comp, num_components, &res, err)) != DACPO_OK)
     goto fail;
-  }
-  for (size_t i = 0; i < n; ++i)
-    raw_size[res.block_of[i]]++;
-  if ((st = seg_renumber(
-           num_raw, raw_size, raw_comp, num_components, &res, remap, err)) != DACPO_OK)
-    goto fail;
-  for (size_t i = 0; i < n; ++i)
-    res.block_of[i] = remap[res.block_of[i]];
-
   if ((st = seg_build_own(n, &res, err)) != DACPO_OK)
     goto fail;
   if ((st = seg_build_rings(adj, component, ring_hops, &res, err)) != DACPO_OK)
@@ -609,8 +677,6 @@ done:
   free(sp.seeds);
   free(raw_comp);
   free(queue);
-  free(raw_size);
-  free(remap);
   return st;
 }
 
