@@ -115,18 +115,12 @@ edge_bias(int64_t ax, int64_t ay, int64_t bx, int64_t by)
   return (dy < 0 || (dy == 0 && dx > 0)) ? 0 : 1;
 }
 
-size_t
-dacpo_raster_triangle(dacpo_raster* r,
-                      const double s0[3],
-                      const double s1[3],
-                      const double s2[3],
-                      int32_t id)
+/* Snaps the vertices to the subpixel grid (X, Y) and orders them counter-
+ * clockwise (positive edge functions inside). Returns twice the snapped area,
+ * 0 for a non-finite, out-of-range or degenerate triangle. */
+static int64_t
+raster_snap_ccw(const double* const v[3], int64_t X[3], int64_t Y[3], double Z[3])
 {
-  if (r == NULL || r->depth == NULL)
-    return 0;
-  const double* v[3] = {s0, s1, s2};
-  int64_t X[3], Y[3];
-  double Z[3];
   for (int k = 0; k < 3; ++k) {
     if (!isfinite(v[k][0]) || !isfinite(v[k][1]) || !isfinite(v[k][2]) ||
         fabs(v[k][0]) > COORD_LIMIT || fabs(v[k][1]) > COORD_LIMIT)
@@ -136,9 +130,7 @@ dacpo_raster_triangle(dacpo_raster* r,
     Z[k] = v[k][2];
   }
   int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
-  if (area == 0)
-    return 0;
-  if (area < 0) { /* make it counter-clockwise (positive edge functions inside) */
+  if (area < 0) {
     int64_t tx = X[1], ty = Y[1];
     double tz = Z[1];
     X[1] = X[2];
@@ -149,8 +141,17 @@ dacpo_raster_triangle(dacpo_raster* r,
     Z[2] = tz;
     area = -area;
   }
+  return area;
+}
 
-  /* Pixel range whose centres (256 x + 128) can fall inside the bounding box. */
+/* Pixel range {px0, px1, py0, py1} whose centres (256 x + 128) can fall inside
+ * the bounding box, clipped to the image. Returns 0 if it is empty. */
+static int
+raster_pixel_range(const dacpo_raster* r,
+                   const int64_t X[3],
+                   const int64_t Y[3],
+                   int64_t range[4])
+{
   int64_t minX = X[0], maxX = X[0], minY = Y[0], maxY = Y[0];
   for (int k = 1; k < 3; ++k) {
     minX = X[k] < minX ? X[k] : minX;
@@ -171,43 +172,71 @@ dacpo_raster_triangle(dacpo_raster* r,
     px1 = (int64_t)r->width - 1;
   if (py1 > (int64_t)r->height - 1)
     py1 = (int64_t)r->height - 1;
-  if (px0 > px1 || py0 > py1)
-    return 0;
+  range[0] = px0;
+  range[1] = px1;
+  range[2] = py0;
+  range[3] = py1;
+  return px0 <= px1 && py0 <= py1;
+}
 
-  /* Edge i is opposite vertex i: e0 = (v1, v2), e1 = (v2, v0), e2 = (v0, v1);
-   * E_i(p) = (b - a) x (p - a); on a step of one pixel it changes by constants. */
+/* Incremental edge functions and depth over the pixel range. */
+typedef struct raster_steps {
+  int64_t step_x[3], step_y[3];
+  int64_t row_start[3]; /* biased: inside iff all three are >= 0 */
+  double z_row, dz_dx, dz_dy;
+} raster_steps;
+
+/* Edge i is opposite vertex i: e0 = (v1, v2), e1 = (v2, v0), e2 = (v0, v1);
+ * E_i(p) = (b - a) x (p - a); on a step of one pixel it changes by constants.
+ * Values at the centre of pixel (px0, py0). */
+static void
+raster_setup_steps(const int64_t X[3],
+                   const int64_t Y[3],
+                   const double Z[3],
+                   int64_t area,
+                   int64_t px0,
+                   int64_t py0,
+                   raster_steps* s)
+{
   const int a_of[3] = {1, 2, 0}, b_of[3] = {2, 0, 1};
-  int64_t step_x[3], step_y[3], row_start[3], bias[3];
+  int64_t bias[3];
+  int64_t half = SUBPIXEL_ONE / 2;
   int64_t cx = px0 * SUBPIXEL_ONE + half, cy = py0 * SUBPIXEL_ONE + half;
   for (int i = 0; i < 3; ++i) {
     int a = a_of[i], b = b_of[i];
-    step_x[i] = -(Y[b] - Y[a]) * SUBPIXEL_ONE;
-    step_y[i] = (X[b] - X[a]) * SUBPIXEL_ONE;
-    row_start[i] = (X[b] - X[a]) * (cy - Y[a]) - (Y[b] - Y[a]) * (cx - X[a]);
+    s->step_x[i] = -(Y[b] - Y[a]) * SUBPIXEL_ONE;
+    s->step_y[i] = (X[b] - X[a]) * SUBPIXEL_ONE;
+    s->row_start[i] = (X[b] - X[a]) * (cy - Y[a]) - (Y[b] - Y[a]) * (cx - X[a]);
     bias[i] = edge_bias(X[a], Y[a], X[b], Y[b]);
   }
   /* z = sum_i E_i Z_i / area is affine in the pixel position: step it. */
   double inv_area = 1.0 / (double)area;
-  double z_row = ((double)row_start[0] * Z[0] + (double)row_start[1] * Z[1] +
-                  (double)row_start[2] * Z[2]) *
-                 inv_area;
-  double dz_dx =
-      ((double)step_x[0] * Z[0] + (double)step_x[1] * Z[1] + (double)step_x[2] * Z[2]) *
-      inv_area;
-  double dz_dy =
-      ((double)step_y[0] * Z[0] + (double)step_y[1] * Z[1] + (double)step_y[2] * Z[2]) *
-      inv_area;
+  s->z_row = ((double)s->row_start[0] * Z[0] + (double)s->row_start[1] * Z[1] +
+              (double)s->row_start[2] * Z[2]) *
+             inv_area;
+  s->dz_dx = ((double)s->step_x[0] * Z[0] + (double)s->step_x[1] * Z[1] +
+              (double)s->step_x[2] * Z[2]) *
+             inv_area;
+  s->dz_dy = ((double)s->step_y[0] * Z[0] + (double)s->step_y[1] * Z[1] +
+              (double)s->step_y[2] * Z[2]) *
+             inv_area;
   /* biased edge values: inside iff all three are >= 0, i.e. their OR is */
   for (int i = 0; i < 3; ++i)
-    row_start[i] -= bias[i];
+    s->row_start[i] -= bias[i];
+}
 
+/* Depth test of every covered pixel centre of the range. Returns how many
+ * centres the triangle covers. */
+static size_t
+raster_scan(dacpo_raster* r, const int64_t range[4], raster_steps* s, int32_t id)
+{
   size_t covered = 0;
-  for (int64_t py = py0; py <= py1; ++py) {
-    int64_t e0 = row_start[0], e1 = row_start[1], e2 = row_start[2];
-    double z = z_row;
+  for (int64_t py = range[2]; py <= range[3]; ++py) {
+    int64_t e0 = s->row_start[0], e1 = s->row_start[1], e2 = s->row_start[2];
+    double z = s->z_row;
     float* drow = r->depth + (size_t)py * r->width;
     int32_t* orow = r->owner + (size_t)py * r->width;
-    for (int64_t px = px0; px <= px1; ++px) {
+    for (int64_t px = range[0]; px <= range[1]; ++px) {
       if ((e0 | e1 | e2) >= 0) {
         ++covered;
         float zf = (float)z;
@@ -216,29 +245,61 @@ dacpo_raster_triangle(dacpo_raster* r,
           orow[px] = id;
         }
       }
-      e0 += step_x[0];
-      e1 += step_x[1];
-      e2 += step_x[2];
-      z += dz_dx;
+      e0 += s->step_x[0];
+      e1 += s->step_x[1];
+      e2 += s->step_x[2];
+      z += s->dz_dx;
     }
-    row_start[0] += step_y[0];
-    row_start[1] += step_y[1];
-    row_start[2] += step_y[2];
-    z_row += dz_dy;
+    s->row_start[0] += s->step_y[0];
+    s->row_start[1] += s->step_y[1];
+    s->row_start[2] += s->step_y[2];
+    s->z_row += s->dz_dy;
   }
-  if (covered > 0) {
-    if (r->x0 > r->x1) {
-      r->x0 = (size_t)px0;
-      r->x1 = (size_t)px1;
-      r->y0 = (size_t)py0;
-      r->y1 = (size_t)py1;
-    }
-    else {
-      r->x0 = (size_t)px0 < r->x0 ? (size_t)px0 : r->x0;
-      r->x1 = (size_t)px1 > r->x1 ? (size_t)px1 : r->x1;
-      r->y0 = (size_t)py0 < r->y0 ? (size_t)py0 : r->y0;
-      r->y1 = (size_t)py1 > r->y1 ? (size_t)py1 : r->y1;
-    }
+  return covered;
+}
+
+/* Grows the dirty rectangle [x0, x1] x [y0, y1] by the range. */
+static void
+raster_grow_box(dacpo_raster* r, const int64_t range[4])
+{
+  size_t px0 = (size_t)range[0], px1 = (size_t)range[1];
+  size_t py0 = (size_t)range[2], py1 = (size_t)range[3];
+  if (r->x0 > r->x1) {
+    r->x0 = px0;
+    r->x1 = px1;
+    r->y0 = py0;
+    r->y1 = py1;
   }
+  else {
+    r->x0 = px0 < r->x0 ? px0 : r->x0;
+    r->x1 = px1 > r->x1 ? px1 : r->x1;
+    r->y0 = py0 < r->y0 ? py0 : r->y0;
+    r->y1 = py1 > r->y1 ? py1 : r->y1;
+  }
+}
+
+size_t
+dacpo_raster_triangle(dacpo_raster* r,
+                      const double s0[3],
+                      const double s1[3],
+                      const double s2[3],
+                      int32_t id)
+{
+  if (r == NULL || r->depth == NULL)
+    return 0;
+  const double* const v[3] = {s0, s1, s2};
+  int64_t X[3], Y[3];
+  double Z[3];
+  int64_t area = raster_snap_ccw(v, X, Y, Z);
+  if (area == 0)
+    return 0;
+  int64_t range[4];
+  if (!raster_pixel_range(r, X, Y, range))
+    return 0;
+  raster_steps steps;
+  raster_setup_steps(X, Y, Z, area, range[0], range[2], &steps);
+  size_t covered = raster_scan(r, range, &steps, id);
+  if (covered > 0)
+    raster_grow_box(r, range);
   return covered;
 }
