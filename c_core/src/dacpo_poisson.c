@@ -920,28 +920,20 @@ ps_build_level(dacpo_poisson* ps, size_t l, size_t band, dacpo_err* err)
   return DACPO_OK;
 }
 
-dacpo_status
-dacpo_poisson_create(const double* xyz,
-                     const double* area,
-                     size_t n,
-                     double spacing,
-                     const dacpo_poisson_params* params,
-                     dacpo_poisson** out,
-                     dacpo_err* err)
+/* Every coordinate finite (their bounding box into lo/hi), every area finite
+ * and >= 0. */
+static dacpo_status
+ps_check_samples(const double* xyz,
+                 const double* area,
+                 size_t n,
+                 double lo[3],
+                 double hi[3],
+                 dacpo_err* err)
 {
-  DACPO_CHECK(err, out, DACPO_ERR_INVALID_ARGUMENT, "poisson: out is NULL");
-  *out = NULL;
-  DACPO_CHECK(err, xyz && params, DACPO_ERR_INVALID_ARGUMENT, "poisson: NULL argument");
-  DACPO_CHECK(err, n > 0, DACPO_ERR_INVALID_ARGUMENT, "poisson: no samples");
-  DACPO_CHECK(err,
-              n <= (size_t)INT32_MAX,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "poisson: %zu samples exceed int32 indices",
-              n);
-  DACPO_TRY(ps_check_params(spacing, params, err));
-
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
-         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = HUGE_VAL;
+    hi[a] = -HUGE_VAL;
+  }
   for (size_t i = 0; i < n; ++i)
     for (int a = 0; a < 3; ++a) {
       double v = xyz[3 * i + a];
@@ -963,6 +955,74 @@ dacpo_poisson_create(const double* xyz,
                   "poisson: area of sample %zu is %g",
                   i,
                   area[i]);
+  return DACPO_OK;
+}
+
+/* alpha in the PSR convention (relative to the box, Kazhdan & Hoppe 2013
+ * Eq. 4) becomes alpha / (box side in cells) once lengths are in cells. */
+static double
+ps_cell_alpha(const dacpo_grid* g, double point_weight)
+{
+  size_t dmax = g->dims[0];
+  for (int a = 1; a < 3; ++a)
+    if (g->dims[a] > dmax)
+      dmax = g->dims[a];
+  return point_weight / (double)dmax;
+}
+
+/* The solver's vectors on the finest and the coarsest level, the coarsest
+ * level's inverse diagonal, and chi = 1/2 (the first solve starts there). */
+static dacpo_status
+ps_alloc_solver(dacpo_poisson* ps, dacpo_err* err)
+{
+  const size_t cells = ps->lv[0].cells;
+  ps->chi = (float*)ps_alloc(ps, cells, sizeof(float), 0);
+  ps->r = (float*)ps_alloc(ps, cells, sizeof(float), 1);
+  ps->z = (float*)ps_alloc(ps, cells, sizeof(float), 1);
+  ps->p = (float*)ps_alloc(ps, cells, sizeof(float), 1);
+  ps->q = (float*)ps_alloc(ps, cells, sizeof(float), 1);
+  const mg_level* Cst = &ps->lv[ps->levels - 1];
+  ps->cr = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
+  ps->cp = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
+  ps->cq = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
+  ps->cz = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
+  ps->cdiag = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
+  if (!ps->chi || !ps->r || !ps->z || !ps->p || !ps->q || !ps->cr || !ps->cp ||
+      !ps->cq || !ps->cz || !ps->cdiag)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < Cst->cells; ++i) {
+    if (!Cst->flags[i])
+      continue;
+    float d = diag_at(Cst, i);
+    ps->cdiag[i] = d > 0.0f ? 1.0f / d : 0.0f;
+  }
+  for (size_t i = 0; i < cells; ++i)
+    ps->chi[i] = 0.5f;
+  ps->iso = 0.5;
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_poisson_create(const double* xyz,
+                     const double* area,
+                     size_t n,
+                     double spacing,
+                     const dacpo_poisson_params* params,
+                     dacpo_poisson** out,
+                     dacpo_err* err)
+{
+  DACPO_CHECK(err, out, DACPO_ERR_INVALID_ARGUMENT, "poisson: out is NULL");
+  *out = NULL;
+  DACPO_CHECK(err, xyz && params, DACPO_ERR_INVALID_ARGUMENT, "poisson: NULL argument");
+  DACPO_CHECK(err, n > 0, DACPO_ERR_INVALID_ARGUMENT, "poisson: no samples");
+  DACPO_CHECK(err,
+              n <= (size_t)INT32_MAX,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "poisson: %zu samples exceed int32 indices",
+              n);
+  DACPO_TRY(ps_check_params(spacing, params, err));
+  double lo[3], hi[3];
+  DACPO_TRY(ps_check_samples(xyz, area, n, lo, hi, err));
 
   dacpo_poisson* ps = (dacpo_poisson*)calloc(1, sizeof(*ps));
   if (!ps)
@@ -980,14 +1040,7 @@ dacpo_poisson_create(const double* xyz,
                        params->max_cells);
     goto fail;
   }
-  const dacpo_grid* g = &ps->grid;
-  size_t dmax = g->dims[0];
-  for (int a = 1; a < 3; ++a)
-    if (g->dims[a] > dmax)
-      dmax = g->dims[a];
-  /* alpha in the PSR convention (relative to the box, Kazhdan & Hoppe 2013
-   * Eq. 4) becomes alpha / (box side in cells) once lengths are in cells. */
-  const double alpha = params->point_weight / (double)dmax;
+  const double alpha = ps_cell_alpha(&ps->grid, params->point_weight);
 
   ps->u = (double*)ps_alloc(ps, 3 * n, sizeof(double), 0);
   ps->w = (double*)ps_alloc(ps, n, sizeof(double), 0);
@@ -1005,33 +1058,8 @@ dacpo_poisson_create(const double* xyz,
       goto fail;
   for (size_t s = 0; s < n; ++s)
     cell_stencil(ps->lv[0].n, ps->u + 3 * s, ps->sc + 8 * s, ps->sw + 8 * s);
-
-  const size_t cells = ps->lv[0].cells;
-  ps->chi = (float*)ps_alloc(ps, cells, sizeof(float), 0);
-  ps->r = (float*)ps_alloc(ps, cells, sizeof(float), 1);
-  ps->z = (float*)ps_alloc(ps, cells, sizeof(float), 1);
-  ps->p = (float*)ps_alloc(ps, cells, sizeof(float), 1);
-  ps->q = (float*)ps_alloc(ps, cells, sizeof(float), 1);
-  const mg_level* Cst = &ps->lv[ps->levels - 1];
-  ps->cr = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  ps->cp = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  ps->cq = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  ps->cz = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  ps->cdiag = (float*)ps_alloc(ps, Cst->cells, sizeof(float), 1);
-  if (!ps->chi || !ps->r || !ps->z || !ps->p || !ps->q || !ps->cr || !ps->cp ||
-      !ps->cq || !ps->cz || !ps->cdiag) {
-    st = DACPO_OOM(err);
+  if ((st = ps_alloc_solver(ps, err)) != DACPO_OK)
     goto fail;
-  }
-  for (size_t i = 0; i < Cst->cells; ++i) {
-    if (!Cst->flags[i])
-      continue;
-    float d = diag_at(Cst, i);
-    ps->cdiag[i] = d > 0.0f ? 1.0f / d : 0.0f;
-  }
-  for (size_t i = 0; i < cells; ++i)
-    ps->chi[i] = 0.5f;
-  ps->iso = 0.5;
   *out = ps;
   return DACPO_OK;
 fail:
