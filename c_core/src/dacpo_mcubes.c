@@ -335,6 +335,58 @@ cube_triangles(dacpo_mcubes* mc,
   return 1;
 }
 
+/* Cube (i, j, kc) of a layer: its corner mask (bit c set where corner c is
+ * above iso) and its triangles, unless a corner is outside the domain or the
+ * cube is not crossed. bx/by: the x/y edge vertex slabs of layers kc and
+ * kc + 1, ez: the z edges between them. Returns 0 on allocation failure. */
+static int
+mc_cube(dacpo_mcubes* mc,
+        const size_t* dims,
+        const float* val,
+        float iso,
+        size_t i,
+        size_t j,
+        size_t kc,
+        const int32_t* const bx[2],
+        const int32_t* const by[2],
+        const int32_t* ez)
+{
+  const size_t nx = dims[0], ny = dims[1], nxy = nx * ny;
+  const uint8_t* c0 = mc->code + nx * (j + ny * kc);
+  const uint8_t cc[8] = {c0[i],
+                         c0[i + 1],
+                         c0[i + nx],
+                         c0[i + nx + 1],
+                         c0[i + nxy],
+                         c0[i + nxy + 1],
+                         c0[i + nxy + nx],
+                         c0[i + nxy + nx + 1]};
+  int mask = 0, inside = 1;
+  for (int c = 0; c < 8; ++c) {
+    inside &= cc[c] != 0;
+    mask |= (cc[c] >> 1) << c;
+  }
+  if (!inside || mask == 0 || mask == 255)
+    return 1;
+  float v[8];
+  for (int c = 0; c < 8; ++c) {
+    size_t idx =
+        (i + (c & 1)) + nx * ((j + ((c >> 1) & 1)) + ny * (kc + ((c >> 2) & 1)));
+    v[c] = val[idx] - iso;
+  }
+  int32_t vid[12];
+  for (int e = 0; e < 4; ++e) {
+    /* e's two bits are the lower corner's other two coordinates */
+    const size_t lo = (size_t)(e & 1), hi = (size_t)(e >> 1);
+    vid[e] = bx[hi][i + nx * (j + lo)];        /* x edges: (y, z) */
+    vid[4 + e] = by[hi][(i + lo) + nx * j];    /* y edges: (x, z) */
+    vid[8 + e] = ez[(i + lo) + nx * (j + hi)]; /* z edges: (x, y) */
+  }
+  int next[12], segface[12];
+  cube_segments(mask, v, next, segface);
+  return cube_triangles(mc, vid, next, segface);
+}
+
 dacpo_status
 dacpo_mcubes_extract(dacpo_mcubes* mc,
                      const dacpo_grid* g,
@@ -373,49 +425,16 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
     for (size_t j = 0; j < ny; ++j)
       if (!row_edges(mc, g, val, j, kc, 2, iso, ez + nx * j))
         return DACPO_OOM(err);
-    const int32_t* bx[2] = {ex[kc & 1], ex[k & 1]};
-    const int32_t* by[2] = {ey[kc & 1], ey[k & 1]};
+    const int32_t* const bx[2] = {ex[kc & 1], ex[k & 1]};
+    const int32_t* const by[2] = {ey[kc & 1], ey[k & 1]};
     for (size_t j = 0; j + 1 < ny; ++j) {
       const uint8_t* ra = mc->rowany;
       if (!ra[j + ny * kc] || !ra[j + 1 + ny * kc] || !ra[j + ny * k] ||
           !ra[j + 1 + ny * k])
         continue;
-      const uint8_t* c0 = mc->code + nx * (j + ny * kc);
-      for (size_t i = 0; i + 1 < nx; ++i) {
-        const uint8_t cc[8] = {c0[i],
-                               c0[i + 1],
-                               c0[i + nx],
-                               c0[i + nx + 1],
-                               c0[i + nxy],
-                               c0[i + nxy + 1],
-                               c0[i + nxy + nx],
-                               c0[i + nxy + nx + 1]};
-        int mask = 0, inside = 1;
-        for (int c = 0; c < 8; ++c) {
-          inside &= cc[c] != 0;
-          mask |= (cc[c] >> 1) << c;
-        }
-        if (!inside || mask == 0 || mask == 255)
-          continue;
-        float v[8];
-        for (int c = 0; c < 8; ++c) {
-          size_t idx =
-              (i + (c & 1)) + nx * ((j + ((c >> 1) & 1)) + ny * (kc + ((c >> 2) & 1)));
-          v[c] = val[idx] - iso;
-        }
-        int32_t vid[12];
-        for (int e = 0; e < 4; ++e) {
-          /* e's two bits are the lower corner's other two coordinates */
-          const size_t lo = (size_t)(e & 1), hi = (size_t)(e >> 1);
-          vid[e] = bx[hi][i + nx * (j + lo)];        /* x edges: (y, z) */
-          vid[4 + e] = by[hi][(i + lo) + nx * j];    /* y edges: (x, z) */
-          vid[8 + e] = ez[(i + lo) + nx * (j + hi)]; /* z edges: (x, y) */
-        }
-        int next[12], segface[12];
-        cube_segments(mask, v, next, segface);
-        if (!cube_triangles(mc, vid, next, segface))
+      for (size_t i = 0; i + 1 < nx; ++i)
+        if (!mc_cube(mc, g->dims, val, iso, i, j, kc, bx, by, ez))
           return DACPO_OOM(err);
-      }
     }
   }
   return DACPO_OK;
