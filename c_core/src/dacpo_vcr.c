@@ -484,94 +484,133 @@ view_eta(vcr_work* w, const dacpo_vcr_params* prm)
   return eta;
 }
 
+/* Widens the rectangle by gap pixels (clipped to the image); the new border
+ * strips are empty. dacpo_raster_clear then resets the filled pixels too. */
+static void
+seam_widen_rect(vcr_work* w, size_t g)
+{
+  dacpo_raster* R = &w->r;
+  const size_t N = w->N;
+  size_t x0 = R->x0 >= g ? R->x0 - g : 0;
+  size_t y0 = R->y0 >= g ? R->y0 - g : 0;
+  size_t x1 = R->x1 + g < N ? R->x1 + g : N - 1;
+  size_t y1 = R->y1 + g < N ? R->y1 + g : N - 1;
+  for (size_t y = y0; y <= y1; ++y)
+    for (size_t x = x0; x <= x1; ++x)
+      if (y < R->y0 || y > R->y1 || x < R->x0 || x > R->x1)
+        w->cls[y * N + x] = 0;
+  R->x0 = x0;
+  R->y0 = y0;
+  R->x1 = x1;
+  R->y1 = y1;
+}
+
+/* The first front: empty pixels next to a drawn one, queued into cur. Returns
+ * their number. */
+static size_t
+seam_first_front(vcr_work* w, int32_t* cur)
+{
+  const dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  const size_t N = w->N;
+  const size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
+  size_t ncur = 0;
+  for (size_t y = y0; y <= y1; ++y)
+    for (size_t x = x0; x <= x1; ++x) {
+      size_t p = y * N + x;
+      if (cls[p] == 0 && ((x > x0 && cls[p - 1] == 1) || (x < x1 && cls[p + 1] == 1) ||
+                          (y > y0 && cls[p - N] == 1) || (y < y1 && cls[p + N] == 1))) {
+        cls[p] = QUEUED;
+        cur[ncur++] = (int32_t)p;
+      }
+    }
+  return ncur;
+}
+
+/* Every front pixel copies the nearest of its sources (drawn or filled in an
+ * earlier round than stamp), then is marked filled in this round. */
+static void
+seam_fill_front(vcr_work* w, const int32_t* cur, size_t ncur, uint8_t stamp)
+{
+  dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  const size_t N = w->N;
+  const size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
+  for (size_t i = 0; i < ncur; ++i) {
+    size_t p = (size_t)cur[i], x = p % N, y = p / N;
+    size_t nb[4];
+    int nn = 0;
+    if (x > x0 && cls[p - 1] != 0 && cls[p - 1] < stamp)
+      nb[nn++] = p - 1;
+    if (x < x1 && cls[p + 1] != 0 && cls[p + 1] < stamp)
+      nb[nn++] = p + 1;
+    if (y > y0 && cls[p - N] != 0 && cls[p - N] < stamp)
+      nb[nn++] = p - N;
+    if (y < y1 && cls[p + N] != 0 && cls[p + N] < stamp)
+      nb[nn++] = p + N;
+    size_t best = nb[0]; /* nn >= 1: p was queued next to a source */
+    for (int k = 1; k < nn; ++k)
+      if (R->depth[nb[k]] < R->depth[best])
+        best = nb[k];
+    R->owner[p] = R->owner[best];
+    R->depth[p] = R->depth[best];
+  }
+  for (size_t i = 0; i < ncur; ++i)
+    cls[cur[i]] = stamp;
+}
+
+/* The next front: the empty neighbours of the current one, queued into next.
+ * Returns their number. */
+static size_t
+seam_next_front(vcr_work* w, const int32_t* cur, size_t ncur, int32_t* next)
+{
+  const dacpo_raster* R = &w->r;
+  uint8_t* cls = w->cls;
+  const size_t N = w->N;
+  const size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
+  size_t nnext = 0;
+  for (size_t i = 0; i < ncur; ++i) {
+    size_t p = (size_t)cur[i], x = p % N, y = p / N;
+    size_t nb[4];
+    int nn = 0;
+    if (x > x0)
+      nb[nn++] = p - 1;
+    if (x < x1)
+      nb[nn++] = p + 1;
+    if (y > y0)
+      nb[nn++] = p - N;
+    if (y < y1)
+      nb[nn++] = p + N;
+    for (int k = 0; k < nn; ++k)
+      if (cls[nb[k]] == 0) {
+        cls[nb[k]] = QUEUED;
+        next[nnext++] = (int32_t)nb[k];
+      }
+  }
+  return nnext;
+}
+
 /* Seam closing: each round, empty pixels next to drawn ones copy the nearest
  * of them. cls marks drawn pixels (1) and the round + 1 a pixel was filled
  * in; pixels outside the rectangle are empty and their cls is stale. */
 static void
 view_close_seams(vcr_work* w, size_t gap)
 {
-  dacpo_raster* R = &w->r;
-  uint8_t* cls = w->cls;
-  const size_t N = w->N;
-  size_t x0 = R->x0, x1 = R->x1, y0 = R->y0, y1 = R->y1;
-  if (gap > 0) {
-    size_t g = gap;
-    x0 = x0 >= g ? x0 - g : 0;
-    y0 = y0 >= g ? y0 - g : 0;
-    x1 = x1 + g < N ? x1 + g : N - 1;
-    y1 = y1 + g < N ? y1 + g : N - 1;
-    for (size_t y = y0; y <= y1; ++y) /* the new border strips are empty */
-      for (size_t x = x0; x <= x1; ++x)
-        if (y < R->y0 || y > R->y1 || x < R->x0 || x > R->x1)
-          cls[y * N + x] = 0;
-    R->x0 = x0; /* so dacpo_raster_clear resets the filled pixels too */
-    R->y0 = y0;
-    R->x1 = x1;
-    R->y1 = y1;
-    /* breadth-first by rounds: only the pixels of the growing front are
-     * visited (cls QUEUED while waiting in a list) */
-    int32_t* cur = w->atom; /* both free until pass 4 */
-    int32_t* next = w->a_par[0];
-    size_t ncur = 0;
-    for (size_t y = y0; y <= y1; ++y)
-      for (size_t x = x0; x <= x1; ++x) {
-        size_t p = y * N + x;
-        if (cls[p] == 0 &&
-            ((x > x0 && cls[p - 1] == 1) || (x < x1 && cls[p + 1] == 1) ||
-             (y > y0 && cls[p - N] == 1) || (y < y1 && cls[p + N] == 1))) {
-          cls[p] = QUEUED;
-          cur[ncur++] = (int32_t)p;
-        }
-      }
-    for (size_t round = 1; round <= g && ncur > 0; ++round) {
-      const uint8_t stamp = (uint8_t)(round + 1);
-      for (size_t i = 0; i < ncur; ++i) {
-        size_t p = (size_t)cur[i], x = p % N, y = p / N;
-        size_t nb[4];
-        int nn = 0;
-        /* sources: drawn or filled in an earlier round */
-        if (x > x0 && cls[p - 1] != 0 && cls[p - 1] < stamp)
-          nb[nn++] = p - 1;
-        if (x < x1 && cls[p + 1] != 0 && cls[p + 1] < stamp)
-          nb[nn++] = p + 1;
-        if (y > y0 && cls[p - N] != 0 && cls[p - N] < stamp)
-          nb[nn++] = p - N;
-        if (y < y1 && cls[p + N] != 0 && cls[p + N] < stamp)
-          nb[nn++] = p + N;
-        size_t best = nb[0]; /* nn >= 1: p was queued next to a source */
-        for (int k = 1; k < nn; ++k)
-          if (R->depth[nb[k]] < R->depth[best])
-            best = nb[k];
-        R->owner[p] = R->owner[best];
-        R->depth[p] = R->depth[best];
-      }
-      for (size_t i = 0; i < ncur; ++i)
-        cls[cur[i]] = stamp;
-      size_t nnext = 0;
-      if (round < g)
-        for (size_t i = 0; i < ncur; ++i) {
-          size_t p = (size_t)cur[i], x = p % N, y = p / N;
-          size_t nb[4];
-          int nn = 0;
-          if (x > x0)
-            nb[nn++] = p - 1;
-          if (x < x1)
-            nb[nn++] = p + 1;
-          if (y > y0)
-            nb[nn++] = p - N;
-          if (y < y1)
-            nb[nn++] = p + N;
-          for (int k = 0; k < nn; ++k)
-            if (cls[nb[k]] == 0) {
-              cls[nb[k]] = QUEUED;
-              next[nnext++] = (int32_t)nb[k];
-            }
-        }
-      int32_t* t = cur;
-      cur = next;
-      next = t;
-      ncur = nnext;
-    }
+  if (gap == 0)
+    return;
+  seam_widen_rect(w, gap);
+  /* breadth-first by rounds: only the pixels of the growing front are
+   * visited (cls QUEUED while waiting in a list) */
+  int32_t* cur = w->atom; /* both free until pass 4 */
+  int32_t* next = w->a_par[0];
+  size_t ncur = seam_first_front(w, cur);
+  for (size_t round = 1; round <= gap && ncur > 0; ++round) {
+    seam_fill_front(w, cur, ncur, (uint8_t)(round + 1));
+    size_t nnext = round < gap ? seam_next_front(w, cur, ncur, next) : 0;
+    int32_t* t = cur;
+    cur = next;
+    next = t;
+    ncur = nnext;
   }
 }
 
