@@ -325,6 +325,79 @@ sort_row(int32_t* v, size_t m)
   }
 }
 
+/* Row starts from the degrees, counting both directions of every listed pair.
+ * Returns the first point listing a neighbour outside [0, n), or n if none
+ * does (*bad gets that neighbour). */
+static size_t
+adj_count_degrees(const dacpo_knn_graph* g, size_t k_use, size_t* start, int32_t* bad)
+{
+  size_t n = g->n, k = g->k;
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t* row = g->idx + i * k;
+    for (size_t j = 0; j < k_use; ++j) {
+      int32_t v = row[j];
+      if (v < 0 || (size_t)v == i)
+        continue;
+      if ((size_t)v >= n) {
+        *bad = v;
+        return i;
+      }
+      ++start[i + 1];
+      ++start[v + 1];
+    }
+  }
+  for (size_t i = 0; i < n; ++i)
+    start[i + 1] += start[i];
+  return n;
+}
+
+/* Both directions of every listed pair into their rows; fill: n scratch. */
+static void
+adj_fill_rows(const dacpo_knn_graph* g,
+              size_t k_use,
+              dacpo_adjacency* out,
+              size_t* fill)
+{
+  size_t n = g->n, k = g->k;
+  memcpy(fill, out->start, n * sizeof(size_t));
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t* row = g->idx + i * k;
+    for (size_t j = 0; j < k_use; ++j) {
+      int32_t v = row[j];
+      if (v < 0 || (size_t)v == i)
+        continue;
+      out->nbr[fill[i]++] = v;
+      out->nbr[fill[v]++] = (int32_t)i;
+    }
+  }
+}
+
+/* Sorts each row, drops repeats (mutual neighbours appear twice), compacts. */
+static void
+adj_sort_unique_rows(dacpo_adjacency* out)
+{
+  size_t n = out->n;
+  size_t w = 0;
+  size_t row_begin = 0;
+  for (size_t i = 0; i < n; ++i) {
+    size_t row_end = out->start[i + 1];
+    int32_t* r = out->nbr + row_begin;
+    size_t m = row_end - row_begin;
+    sort_row(r, m);
+    out->start[i] = w;
+    for (size_t j = 0; j < m; ++j)
+      if (j == 0 || r[j] != r[j - 1])
+        out->nbr[w++] = r[j];
+    row_begin = row_end;
+  }
+  out->start[n] = w;
+  if (w > 0) {
+    int32_t* shrunk = realloc(out->nbr, w * sizeof(int32_t));
+    if (shrunk)
+      out->nbr = shrunk;
+  }
+}
+
 dacpo_status
 dacpo_adjacency_build(const dacpo_knn_graph* g,
                       size_t k_use,
@@ -345,28 +418,17 @@ dacpo_adjacency_build(const dacpo_knn_graph* g,
   out->start = dacpo_calloc_array(n + 1, sizeof(size_t));
   if (!out->start)
     return DACPO_OOM(err);
-  /* degrees, counting both directions of every listed pair */
-  for (size_t i = 0; i < n; ++i) {
-    const int32_t* row = g->idx + i * k;
-    for (size_t j = 0; j < k_use; ++j) {
-      int32_t v = row[j];
-      if (v < 0 || (size_t)v == i)
-        continue;
-      if ((size_t)v >= n) {
-        dacpo_adjacency_free(out);
-        return dacpo_err_set(err,
-                             DACPO_ERR_INTERNAL,
-                             "adjacency: point %zu lists neighbour %d outside [0, %zu)",
-                             i,
-                             (int)v,
-                             n);
-      }
-      ++out->start[i + 1];
-      ++out->start[v + 1];
-    }
+  int32_t bad = 0;
+  size_t bad_point = adj_count_degrees(g, k_use, out->start, &bad);
+  if (bad_point < n) {
+    dacpo_adjacency_free(out);
+    return dacpo_err_set(err,
+                         DACPO_ERR_INTERNAL,
+                         "adjacency: point %zu lists neighbour %d outside [0, %zu)",
+                         bad_point,
+                         (int)bad,
+                         n);
   }
-  for (size_t i = 0; i < n; ++i)
-    out->start[i + 1] += out->start[i];
   out->nbr = dacpo_malloc_array(out->start[n], sizeof(int32_t));
   size_t* fill = dacpo_malloc_array(n, sizeof(size_t));
   if (!out->nbr || !fill) {
@@ -374,38 +436,9 @@ dacpo_adjacency_build(const dacpo_knn_graph* g,
     dacpo_adjacency_free(out);
     return DACPO_OOM(err);
   }
-  memcpy(fill, out->start, n * sizeof(size_t));
-  for (size_t i = 0; i < n; ++i) {
-    const int32_t* row = g->idx + i * k;
-    for (size_t j = 0; j < k_use; ++j) {
-      int32_t v = row[j];
-      if (v < 0 || (size_t)v == i)
-        continue;
-      out->nbr[fill[i]++] = v;
-      out->nbr[fill[v]++] = (int32_t)i;
-    }
-  }
+  adj_fill_rows(g, k_use, out, fill);
   free(fill);
-  /* sort each row, drop repeats (mutual neighbours appear twice), compact */
-  size_t w = 0;
-  size_t row_begin = 0;
-  for (size_t i = 0; i < n; ++i) {
-    size_t row_end = out->start[i + 1];
-    int32_t* r = out->nbr + row_begin;
-    size_t m = row_end - row_begin;
-    sort_row(r, m);
-    out->start[i] = w;
-    for (size_t j = 0; j < m; ++j)
-      if (j == 0 || r[j] != r[j - 1])
-        out->nbr[w++] = r[j];
-    row_begin = row_end;
-  }
-  out->start[n] = w;
-  if (w > 0) {
-    int32_t* shrunk = realloc(out->nbr, w * sizeof(int32_t));
-    if (shrunk)
-      out->nbr = shrunk;
-  }
+  adj_sort_unique_rows(out);
   return DACPO_OK;
 }
 
