@@ -68,6 +68,85 @@ dacpo_view_score(const double* sp,
   return m ? total / (double)m : 0.0;
 }
 
+/* Point count of every part into size; returns the largest part (the lowest
+ * index among equals). */
+static size_t
+part_largest(const int32_t* part, size_t n, size_t num_parts, size_t* size)
+{
+  for (size_t i = 0; i < n; ++i)
+    size[part[i]]++;
+  size_t big = 0;
+  for (size_t c = 1; c < num_parts; ++c)
+    if (size[c] > size[big])
+      big = c;
+  return big;
+}
+
+/* The candidates do not depend on the run's seed: the parts' relation is a
+ * property of the scene, every seed should find the same one. Two stacked
+ * parts (a table top over the floor) are explained as well by a viewpoint
+ * above both as by one between them that the upper part hides; among
+ * candidates that explain the sample equally well (within 0.05 %) the one
+ * farther from the points is kept, since a sensor stands back from what it
+ * scans. Returns the best score (-1 without sample), its viewpoint in best_v.
+ * vote: num_parts scratch. */
+static double
+part_best_viewpoint(const dacpo_view_sample* vs,
+                    double* vote,
+                    size_t num_parts,
+                    double best_v[3])
+{
+  dacpo_rng rng;
+  dacpo_view_rng_seed(&rng);
+  double facing = -1.0, best_dist = 0.0;
+  for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && vs->m > 0; ++k) {
+    double v[3];
+    dacpo_view_candidate(vs, &rng, k, v);
+    double dist;
+    const double score =
+        dacpo_view_score(vs->p, vs->n, vs->part, vs->m, v, vote, num_parts, &dist);
+    if (score > facing + DACPO_VIEW_TIE ||
+        (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
+      facing = fmax(score, facing);
+      best_dist = dist;
+      memcpy(best_v, v, 3 * sizeof(double));
+    }
+  }
+  return facing;
+}
+
+/* Every point votes; the largest part keeps its sign (the others follow it),
+ * so flip the votes when the largest one does not face v. */
+static void
+part_signs_facing(const double* xyz,
+                  const double* nrm,
+                  size_t n,
+                  const int32_t* part,
+                  size_t num_parts,
+                  const double v[3],
+                  const size_t* size,
+                  size_t big,
+                  double* vote,
+                  int8_t* sign,
+                  double* confidence)
+{
+  memset(vote, 0, num_parts * sizeof(double));
+  for (size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    const double* q = nrm + 3 * i;
+    const double f = q[0] * (v[0] - p[0]) + q[1] * (v[1] - p[1]) + q[2] * (v[2] - p[2]);
+    vote[part[i]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
+  }
+  const double ref = vote[big] < 0.0 ? -1.0 : 1.0;
+  for (size_t c = 0; c < num_parts; ++c) {
+    if (size[c] == 0)
+      continue;
+    sign[c] = vote[c] * ref < 0.0 ? -1 : 1;
+    confidence[c] = fabs(vote[c]) / (double)size[c];
+  }
+  sign[big] = 1;
+}
+
 dacpo_status
 dacpo_part_signs(const double* xyz,
                  const double* nrm,
@@ -103,58 +182,14 @@ dacpo_part_signs(const double* xyz,
       dacpo_view_sample_free(&vs);
     return st == DACPO_OK ? DACPO_OOM(err) : st;
   }
-  for (size_t i = 0; i < n; ++i)
-    size[part[i]]++;
-  size_t big = 0;
-  for (size_t c = 1; c < num_parts; ++c)
-    if (size[c] > size[big])
-      big = c;
-
-  /* The candidates do not depend on the run's seed: the parts' relation is a
-   * property of the scene, every seed should find the same one. Two stacked
-   * parts (a table top over the floor) are explained as well by a viewpoint
-   * above both as by one between them that the upper part hides; among
-   * candidates that explain the sample equally well (within 0.05 %) the one
-   * farther from the points is kept, since a sensor stands back from what it
-   * scans. */
-  dacpo_rng rng;
-  dacpo_view_rng_seed(&rng);
-  double best_v[3] = {0.0, 0.0, 0.0}, facing = -1.0, best_dist = 0.0;
-  for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && vs.m > 0; ++k) {
-    double v[3];
-    dacpo_view_candidate(&vs, &rng, k, v);
-    double dist;
-    const double score =
-        dacpo_view_score(vs.p, vs.n, vs.part, vs.m, v, vote, num_parts, &dist);
-    if (score > facing + DACPO_VIEW_TIE ||
-        (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
-      facing = fmax(score, facing);
-      best_dist = dist;
-      memcpy(best_v, v, sizeof(best_v));
-    }
-  }
+  const size_t big = part_largest(part, n, num_parts, size);
+  double best_v[3] = {0.0, 0.0, 0.0};
+  const double facing = part_best_viewpoint(&vs, vote, num_parts, best_v);
   if (score_out)
     *score_out = facing;
-  if (facing >= DACPO_VIEW_MIN_SCORE) {
-    /* Every point votes; the largest part keeps its sign (the others
-     * follow it), so flip the votes when the largest one does not face v. */
-    memset(vote, 0, num_parts * sizeof(double));
-    for (size_t i = 0; i < n; ++i) {
-      const double* p = xyz + 3 * i;
-      const double* q = nrm + 3 * i;
-      const double f = q[0] * (best_v[0] - p[0]) + q[1] * (best_v[1] - p[1]) +
-                       q[2] * (best_v[2] - p[2]);
-      vote[part[i]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
-    }
-    const double ref = vote[big] < 0.0 ? -1.0 : 1.0;
-    for (size_t c = 0; c < num_parts; ++c) {
-      if (size[c] == 0)
-        continue;
-      sign[c] = vote[c] * ref < 0.0 ? -1 : 1;
-      confidence[c] = fabs(vote[c]) / (double)size[c];
-    }
-    sign[big] = 1;
-  }
+  if (facing >= DACPO_VIEW_MIN_SCORE)
+    part_signs_facing(
+        xyz, nrm, n, part, num_parts, best_v, size, big, vote, sign, confidence);
   confidence[big] = 1.0;
   free(size);
   free(vote);
