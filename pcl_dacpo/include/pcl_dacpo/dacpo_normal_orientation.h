@@ -742,6 +742,9 @@ private:
     std::vector<std::size_t> local_to_out;
     std::vector<float> xyz, nrm, given_curvature;
   };
+  /** \brief Forgets the status, stats and results of the previous run. */
+  void
+  clearResults();
   /** \brief Rejects the set-ups DACPO does not support (false: output failed). */
   bool
   checkSetup(PointCloudOut& output);
@@ -749,6 +752,14 @@ private:
    *  ones; output.is_dense tells whether all were. */
   void
   packPoints(PointCloudOut& output, Packed& packed) const;
+  /** \brief Rejects an empty or too large packed cloud (false: output failed); warns
+   *  when k is not smaller than the usable points. */
+  bool
+  checkPacked(PointCloudOut& output, const Packed& packed);
+  /** \brief Runs the core on the packed points with the search and progress
+   *  adapters and copies its results (false: output failed). */
+  bool
+  orientPacked(PointCloudOut& output, const dacpo_params& params, Packed& packed);
   /** \brief Normals, curvature, labels, confidence, flips, edges and mesh of a run. */
   void
   copyResults(PointCloudOut& output, const dacpo_ctx* ctx, const Packed& packed);

@@ -411,7 +411,7 @@ DACPONormalOrientation<PointInT, PointOutT>::warnAboutRun(
 
 template <typename PointInT, typename PointOutT>
 void
-DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& output)
+DACPONormalOrientation<PointInT, PointOutT>::clearResults()
 {
   last_status_ = DACPO_OK;
   last_error_.clear();
@@ -423,27 +423,25 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   edges_.clear();
   mesh_vertices_.clear();
   mesh_triangles_.clear();
+}
 
-  if (!checkSetup(output))
-    return;
-
+template <typename PointInT, typename PointOutT>
+bool
+DACPONormalOrientation<PointInT, PointOutT>::checkPacked(PointCloudOut& output,
+                                                         const Packed& packed)
+{
   const std::size_t n_out = indices_->size();
-  Packed packed;
-  packPoints(output, packed);
-  std::vector<pcl::index_t>& local_to_cloud = packed.local_to_cloud;
-  std::vector<float>& xyz = packed.xyz;
-  std::vector<float>& nrm = packed.nrm;
-  const std::size_t m = local_to_cloud.size();
+  const std::size_t m = packed.local_to_cloud.size();
   if (m == 0) {
     fail(output,
          DACPO_ERR_EMPTY_INPUT,
          "none of the " + std::to_string(n_out) +
              " points has finite coordinates (and a usable input normal)");
-    return;
+    return false;
   }
   if (m >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
     fail(output, DACPO_ERR_INVALID_ARGUMENT, "too many points for 32-bit indices");
-    return;
+    return false;
   }
   if (static_cast<std::size_t>(k_) >= m)
     PCL_WARN("[pcl::%s::computeFeature] k = %d is not smaller than the %zu usable "
@@ -451,7 +449,17 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
              getClassName().c_str(),
              k_,
              m);
+  return true;
+}
 
+template <typename PointInT, typename PointOutT>
+bool
+DACPONormalOrientation<PointInT, PointOutT>::orientPacked(PointCloudOut& output,
+                                                          const dacpo_params& params,
+                                                          Packed& packed)
+{
+  const std::vector<pcl::index_t>& local_to_cloud = packed.local_to_cloud;
+  const std::size_t m = local_to_cloud.size();
   std::vector<std::int32_t> cloud_to_local(input_->size(), -1);
   for (std::size_t j = 0; j < m; ++j)
     cloud_to_local[local_to_cloud[j]] = static_cast<std::int32_t>(j);
@@ -478,24 +486,19 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
   progress.fn = &dacpo_detail::ProgressAdapter<ProgressCallback>::call;
   progress.user = &progress_adapter;
 
-  dacpo_params params = getParameters();
-  if (use_sensor_origin_)
-    for (int d = 0; d < 3; ++d)
-      params.viewpoint[d] = static_cast<double>(input_->sensor_origin_[d]);
-
   dacpo_ctx* raw = nullptr;
   dacpo_status status = dacpo_ctx_create(&raw);
   dacpo_detail::ContextPtr ctx(raw);
   if (status != DACPO_OK) {
     fail(output, status, "could not create a DACPO context");
-    return;
+    return false;
   }
   status = dacpo_orient(ctx.get(),
                         &params,
                         &search,
                         progress_ ? &progress : nullptr,
-                        xyz.data(),
-                        nrm.data(),
+                        packed.xyz.data(),
+                        packed.nrm.data(),
                         m);
   if (const dacpo_stats* s = dacpo_ctx_stats(ctx.get()))
     stats_ = *s;
@@ -508,10 +511,30 @@ DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& outpu
     if (!progress_error.empty())
       message += " (" + progress_error + ")";
     fail(output, status, message);
-    return;
+    return false;
   }
-
   copyResults(output, ctx.get(), packed);
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::computeFeature(PointCloudOut& output)
+{
+  clearResults();
+  if (!checkSetup(output))
+    return;
+  Packed packed;
+  packPoints(output, packed);
+  if (!checkPacked(output, packed))
+    return;
+
+  dacpo_params params = getParameters();
+  if (use_sensor_origin_)
+    for (int d = 0; d < 3; ++d)
+      params.viewpoint[d] = static_cast<double>(input_->sensor_origin_[d]);
+  if (!orientPacked(output, params, packed))
+    return;
   warnAboutRun(params);
 }
 
