@@ -503,59 +503,60 @@ struct ProgressLine {
   }
 };
 
-bool
-compute(const pcl::PCLPointCloud2& input,
-        const Options& options,
-        pcl::PCLPointCloud2& output,
-        Result& result)
+/* The input's points as floats in the local frame. Unorganized on purpose: PCL
+ * would pick OrganizedNeighbor for an organized cloud, which needs a projective
+ * sensor. The output keeps the input's width x height. */
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+localCloud(const std::vector<double>& coords,
+           const dacpo_tool::LocalFrame& frame,
+           std::size_t n)
 {
-  const std::size_t n = static_cast<std::size_t>(input.width) * input.height;
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
-  const std::vector<double> coords =
-      dacpo_tool::readTriplet<double>(input, "x", "y", "z");
-  /* Read in double and, where float is at risk (georeferenced offsets, huge
-   * or tiny clouds: dacpo_tool::localFrame), moved to a local frame:
-   * orientation does not depend on position or scale. The output keeps the
-   * input's own coordinates. */
-  const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(coords);
-  /* Unorganized on purpose: PCL would pick OrganizedNeighbor for an organized
-   * cloud, which needs a projective sensor. The output keeps the input's
-   * width x height. */
   xyz->resize(n);
   xyz->is_dense = false;
   for (std::size_t i = 0; i < n; ++i)
     for (int d = 0; d < 3; ++d)
       (*xyz)[i].data[d] =
           static_cast<float>((coords[3 * i + d] - frame.centre[d]) / frame.scale);
+  return xyz;
+}
 
-  pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
-  dacpo.setInputCloud(xyz);
-  dacpo_params params = options.params;
-  for (int d = 0; d < 3; ++d) /* -vp is given in the input's frame */
-    params.viewpoint[d] = (params.viewpoint[d] - frame.centre[d]) / frame.scale;
-  dacpo.setParameters(params);
+/* The input's normals (and curvature, 0 if absent) as a PCL cloud. */
+pcl::PointCloud<pcl::Normal>::Ptr
+inputNormals(const pcl::PCLPointCloud2& input, std::size_t n)
+{
+  const std::vector<float> nv =
+      dacpo_tool::readTriplet(input, "normal_x", "normal_y", "normal_z");
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  normals->resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    (*normals)[i].normal_x = nv[3 * i];
+    (*normals)[i].normal_y = nv[3 * i + 1];
+    (*normals)[i].normal_z = nv[3 * i + 2];
+    (*normals)[i].curvature = 0.0f;
+  }
+  if (dacpo_tool::hasFields(input, {"curvature"})) {
+    const int f = pcl::getFieldIndex(input, "curvature");
+    for (std::size_t i = 0; i < n; ++i)
+      (*normals)[i].curvature = static_cast<float>(dacpo_tool::readValue(
+          &input.data[i * input.point_step + input.fields[f].offset],
+          input.fields[f].datatype));
+  }
+  return normals;
+}
 
+/* Gives the run the input's normals unless they are absent or -estimate asks
+ * for PCA normals; says which. */
+void
+chooseNormals(const pcl::PCLPointCloud2& input,
+              const Options& options,
+              std::size_t n,
+              pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal>& dacpo)
+{
   const bool has_normals =
       dacpo_tool::hasFields(input, {"normal_x", "normal_y", "normal_z"});
   if (has_normals && !options.estimate) {
-    const std::vector<float> nv =
-        dacpo_tool::readTriplet(input, "normal_x", "normal_y", "normal_z");
-    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-    normals->resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      (*normals)[i].normal_x = nv[3 * i];
-      (*normals)[i].normal_y = nv[3 * i + 1];
-      (*normals)[i].normal_z = nv[3 * i + 2];
-      (*normals)[i].curvature = 0.0f;
-    }
-    if (dacpo_tool::hasFields(input, {"curvature"})) {
-      const int f = pcl::getFieldIndex(input, "curvature");
-      for (std::size_t i = 0; i < n; ++i)
-        (*normals)[i].curvature = static_cast<float>(dacpo_tool::readValue(
-            &input.data[i * input.point_step + input.fields[f].offset],
-            input.fields[f].datatype));
-    }
-    dacpo.setInputNormals(normals);
+    dacpo.setInputNormals(inputNormals(input, n));
     info("Orienting the input normals (k = ");
   }
   else {
@@ -566,27 +567,12 @@ compute(const pcl::PCLPointCloud2& input,
   }
   value("%zu", options.params.k);
   info(")\n");
+}
 
-  ProgressLine line;
-  const bool show_progress = !options.quiet && isatty(2);
-  if (show_progress)
-    dacpo.setProgressCallback(std::ref(line));
-
-  TicToc tt;
-  tt.tic();
-  pcl::PointCloud<pcl::Normal> normals_out;
-  dacpo.compute(normals_out);
-  if (show_progress)
-    std::fprintf(stderr, "\r%78s\r", "");
-  if (normals_out.size() != n) {
-    print_error("Error: orientation failed: %s: %s\n",
-                dacpo.statusString(dacpo.getLastStatus()),
-                dacpo.getLastError().c_str());
-    return false;
-  }
-  const double ms = tt.toc();
-
-  const dacpo_stats s = dacpo.getStats();
+/* The run's summary and stage times (not with -q). */
+void
+printRunSummary(const dacpo_stats& s, double ms)
+{
   info("Oriented ");
   value("%zu", s.input_points);
   info(" points (");
@@ -610,22 +596,40 @@ compute(const pcl::PCLPointCloud2& input,
   }
   info(" | total ");
   value("%.3f\n", s.total_seconds);
+}
 
+/* Stats, labels, edges and mesh of the run; the mesh back in the input frame. */
+void
+collectResult(const pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal>& dacpo,
+              const dacpo_tool::LocalFrame& frame,
+              std::size_t n,
+              Result& result)
+{
   result.points = n;
-  result.stats = s;
+  result.stats = dacpo.getStats();
   result.blocks = dacpo.getBlockLabels();
   result.components = dacpo.getComponentLabels();
   result.confidence = dacpo.getPointConfidence();
   result.flips = dacpo.getBlockFlips();
   result.edges = dacpo.getEdges();
   result.mesh_vertices = dacpo.getMeshVertices();
-  for (std::size_t i = 0; i < result.mesh_vertices.size();
-       ++i) /* back to the input frame */
+  for (std::size_t i = 0; i < result.mesh_vertices.size(); ++i)
     result.mesh_vertices[i] =
         static_cast<float>(result.mesh_vertices[i] * frame.scale + frame.centre[i % 3]);
   result.mesh_triangles = dacpo.getMeshTriangles();
+}
 
-  /* Keep every input field except the ones we write, then append ours. */
+/* The output cloud: every input field except the ones we write, then the
+ * normals and curvature, and with -labels block, component, flip and
+ * confidence. */
+bool
+buildOutput(const pcl::PCLPointCloud2& input,
+            const pcl::PointCloud<pcl::Normal>& normals_out,
+            const Options& options,
+            const Result& result,
+            pcl::PCLPointCloud2& output)
+{
+  const std::size_t n = result.points;
   pcl::PCLPointCloud2 stripped = dacpo_tool::removeFields(input,
                                                           {"normal_x",
                                                            "normal_y",
@@ -645,27 +649,73 @@ compute(const pcl::PCLPointCloud2& input,
   output = dacpo_tool::appendFloatFields(
       stripped, {"normal_x", "normal_y", "normal_z", "curvature"}, values);
   output.is_dense = normals_out.is_dense && input.is_dense;
-  if (options.labels) {
-    if (result.blocks.size() != n || result.components.size() != n) {
-      print_error("Error: the run left no block labels\n");
-      return false;
-    }
-    std::vector<std::int32_t> labels(3 * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const int b = result.blocks[i];
-      labels[3 * i] = b;
-      labels[3 * i + 1] = result.components[i];
-      labels[3 * i + 2] = b >= 0 && static_cast<std::size_t>(b) < result.flips.size()
-                              ? result.flips[b]
-                              : -1;
-    }
-    const bool dense = output.is_dense;
-    output = dacpo_tool::appendInt32Fields(output, kLabelFields, labels);
-    if (result.confidence.size() == n)
-      output = dacpo_tool::appendFloatFields(output, {"confidence"}, result.confidence);
-    output.is_dense = dense;
+  if (!options.labels)
+    return true;
+  if (result.blocks.size() != n || result.components.size() != n) {
+    print_error("Error: the run left no block labels\n");
+    return false;
   }
+  std::vector<std::int32_t> labels(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int b = result.blocks[i];
+    labels[3 * i] = b;
+    labels[3 * i + 1] = result.components[i];
+    labels[3 * i + 2] = b >= 0 && static_cast<std::size_t>(b) < result.flips.size()
+                            ? result.flips[b]
+                            : -1;
+  }
+  const bool dense = output.is_dense;
+  output = dacpo_tool::appendInt32Fields(output, kLabelFields, labels);
+  if (result.confidence.size() == n)
+    output = dacpo_tool::appendFloatFields(output, {"confidence"}, result.confidence);
+  output.is_dense = dense;
   return true;
+}
+
+bool
+compute(const pcl::PCLPointCloud2& input,
+        const Options& options,
+        pcl::PCLPointCloud2& output,
+        Result& result)
+{
+  const std::size_t n = static_cast<std::size_t>(input.width) * input.height;
+  const std::vector<double> coords =
+      dacpo_tool::readTriplet<double>(input, "x", "y", "z");
+  /* Read in double and, where float is at risk (georeferenced offsets, huge
+   * or tiny clouds: dacpo_tool::localFrame), moved to a local frame:
+   * orientation does not depend on position or scale. The output keeps the
+   * input's own coordinates. */
+  const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(coords);
+
+  pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
+  dacpo.setInputCloud(localCloud(coords, frame, n));
+  dacpo_params params = options.params;
+  for (int d = 0; d < 3; ++d) /* -vp is given in the input's frame */
+    params.viewpoint[d] = (params.viewpoint[d] - frame.centre[d]) / frame.scale;
+  dacpo.setParameters(params);
+  chooseNormals(input, options, n, dacpo);
+
+  ProgressLine line;
+  const bool show_progress = !options.quiet && isatty(2);
+  if (show_progress)
+    dacpo.setProgressCallback(std::ref(line));
+
+  TicToc tt;
+  tt.tic();
+  pcl::PointCloud<pcl::Normal> normals_out;
+  dacpo.compute(normals_out);
+  if (show_progress)
+    std::fprintf(stderr, "\r%78s\r", "");
+  if (normals_out.size() != n) {
+    print_error("Error: orientation failed: %s: %s\n",
+                dacpo.statusString(dacpo.getLastStatus()),
+                dacpo.getLastError().c_str());
+    return false;
+  }
+  const double ms = tt.toc();
+  printRunSummary(dacpo.getStats(), ms);
+  collectResult(dacpo, frame, n, result);
+  return buildOutput(input, normals_out, options, result, output);
 }
 
 bool
@@ -888,11 +938,11 @@ optionNames(bool with_value)
   return names;
 }
 
+/* Applies the options in command-line order: a repeated option keeps its last
+ * value. */
 bool
-parseOptions(int argc, char** argv, Options& o)
+applyOptions(int argc, char** argv, Options& o)
 {
-  dacpo_params_init(&o.params);
-  /* in command-line order: a repeated option keeps its last value */
   for (int i = 1; i < argc; ++i) {
     const OptionSpec* spec = findOption(argv[i]);
     if (spec == nullptr)
@@ -914,6 +964,13 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
+  return true;
+}
+
+/* -sign and -vp into the sign policy (and the viewpoint). */
+bool
+resolveSignPolicy(Options& o)
+{
   if (!o.sign.empty()) {
     if (o.sign == "free")
       o.params.sign_policy = DACPO_SIGN_FREE_SPACE;
@@ -927,29 +984,32 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
-  if (!o.viewpoint.empty()) {
-    double v[3];
-    std::stringstream in(o.viewpoint);
-    std::string part;
-    int got = 0;
-    while (got < 4 && std::getline(in, part, ','))
-      got += got < 3 && toDouble(part, v[got]) ? 1 : 4;
-    if (got != 3) {
-      print_error("Error: -vp needs three finite numbers x,y,z\n");
-      return false;
-    }
-    if (o.params.sign_policy == DACPO_SIGN_KEEP) {
-      print_error("Error: -vp and -sign keep contradict each other\n");
-      return false;
-    }
-    o.params.sign_policy = DACPO_SIGN_VIEWPOINT;
-    for (int k = 0; k < 3; ++k)
-      o.params.viewpoint[k] = v[k];
+  if (o.viewpoint.empty())
+    return true;
+  double v[3];
+  std::stringstream in(o.viewpoint);
+  std::string part;
+  int got = 0;
+  while (got < 4 && std::getline(in, part, ','))
+    got += got < 3 && toDouble(part, v[got]) ? 1 : 4;
+  if (got != 3) {
+    print_error("Error: -vp needs three finite numbers x,y,z\n");
+    return false;
   }
-  if (o.separate)
-    o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
-  if (o.bridge)
-    o.params.disconnected = DACPO_DISCONNECTED_BRIDGE;
+  if (o.params.sign_policy == DACPO_SIGN_KEEP) {
+    print_error("Error: -vp and -sign keep contradict each other\n");
+    return false;
+  }
+  o.params.sign_policy = DACPO_SIGN_VIEWPOINT;
+  for (int k = 0; k < 3; ++k)
+    o.params.viewpoint[k] = v[k];
+  return true;
+}
+
+/* -mesh, the batch folders and the side outputs: extensions and combinations. */
+bool
+checkFileOptions(Options& o)
+{
   if (!o.mesh.empty()) {
     if (dacpo_tool::extension(o.mesh) != ".ply") {
       print_error("Error: -mesh needs a .ply file name, got '%s'\n", o.mesh.c_str());
@@ -981,6 +1041,21 @@ parseOptions(int argc, char** argv, Options& o)
       return false;
     }
   }
+  return true;
+}
+
+bool
+parseOptions(int argc, char** argv, Options& o)
+{
+  dacpo_params_init(&o.params);
+  if (!applyOptions(argc, argv, o) || !resolveSignPolicy(o))
+    return false;
+  if (o.separate)
+    o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
+  if (o.bridge)
+    o.params.disconnected = DACPO_DISCONNECTED_BRIDGE;
+  if (!checkFileOptions(o))
+    return false;
   o.params.estimate_normals = 0; /* decided per input in compute() */
   dacpo_params check = o.params;
   check.estimate_normals = 1;
