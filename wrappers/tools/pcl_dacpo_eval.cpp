@@ -339,62 +339,77 @@ saveColored(const std::string& path,
   return true;
 }
 
-} // namespace
+/* The command line of the tool. */
+struct EvalOptions {
+  std::vector<std::string> files; /* ground truth, prediction */
+  std::string colored, normals_colored;
+  bool json = false;
+};
 
-int
-main(int argc, char** argv)
+/* Reads and checks the command line; false: exit with *exit_code (help, or a
+ * message was printed). */
+bool
+parseEvalOptions(int argc, char** argv, EvalOptions& o, int& exit_code)
 {
   const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  exit_code = 1;
   if (argc < 3 || help) {
     printHelp(argc, argv);
-    return help ? 0 : 1;
+    exit_code = help ? 0 : 1;
+    return false;
   }
-  {
-    std::string error;
-    if (!dacpo_tool::checkArguments(
-            argc, argv, {"-json"}, {"-colored", "-normals_colored"}, error)) {
-      print_error("Error: %s\n", error.c_str());
-      return 1;
-    }
+  std::string error;
+  if (!dacpo_tool::checkArguments(
+          argc, argv, {"-json"}, {"-colored", "-normals_colored"}, error)) {
+    print_error("Error: %s\n", error.c_str());
+    return false;
   }
-  const std::vector<std::string> files =
-      dacpo_tool::fileArguments(argc, argv, {"-colored", "-normals_colored"});
-  if (files.size() != 2) {
+  o.files = dacpo_tool::fileArguments(argc, argv, {"-colored", "-normals_colored"});
+  if (o.files.size() != 2) {
     print_error("Need a ground-truth and a predicted file (.pcd or .ply), got %zu.\n",
-                files.size());
+                o.files.size());
     printHelp(argc, argv);
-    return 1;
+    return false;
   }
-  std::string colored, normals_colored;
-  parse_argument(argc, argv, "-colored", colored);
-  parse_argument(argc, argv, "-normals_colored", normals_colored);
-  if (!normals_colored.empty() && dacpo_tool::extension(normals_colored) != ".pcd" &&
-      dacpo_tool::extension(normals_colored) != ".ply") {
+  parse_argument(argc, argv, "-colored", o.colored);
+  parse_argument(argc, argv, "-normals_colored", o.normals_colored);
+  if (!o.normals_colored.empty() &&
+      dacpo_tool::extension(o.normals_colored) != ".pcd" &&
+      dacpo_tool::extension(o.normals_colored) != ".ply") {
     print_error("Error: -normals_colored needs a .pcd or .ply file name, got '%s'\n",
-                normals_colored.c_str());
-    return 1;
+                o.normals_colored.c_str());
+    return false;
   }
-  if (!colored.empty() && dacpo_tool::extension(colored) != ".pcd") {
-    print_error("Error: -colored needs a .pcd file name, got '%s'\n", colored.c_str());
-    return 1;
+  if (!o.colored.empty() && dacpo_tool::extension(o.colored) != ".pcd") {
+    print_error("Error: -colored needs a .pcd file name, got '%s'\n",
+                o.colored.c_str());
+    return false;
   }
-  const bool json = find_switch(argc, argv, "-json");
+  o.json = find_switch(argc, argv, "-json");
+  return true;
+}
 
-  pcl::PCLPointCloud2 gt2, pred2;
+/* Loads both files: each with normals, the same number of points, not none. */
+bool
+loadPair(const std::vector<std::string>& files,
+         pcl::PCLPointCloud2& gt2,
+         pcl::PCLPointCloud2& pred2,
+         std::size_t& n)
+{
   std::string error;
   for (int f = 0; f < 2; ++f) {
     pcl::PCLPointCloud2& c = f == 0 ? gt2 : pred2;
     if (!dacpo_tool::loadCloud2(files[f], c, error)) {
       print_error("Error: %s\n", error.c_str());
-      return 1;
+      return false;
     }
     if (!dacpo_tool::hasFields(c, {"normal_x", "normal_y", "normal_z"})) {
       print_error("Error: '%s' has no normals (normal_x/y/z or nx/ny/nz)\n",
                   files[f].c_str());
-      return 1;
+      return false;
     }
   }
-  const std::size_t n = static_cast<std::size_t>(gt2.width) * gt2.height;
+  n = static_cast<std::size_t>(gt2.width) * gt2.height;
   const std::size_t n_pred = static_cast<std::size_t>(pred2.width) * pred2.height;
   if (n != n_pred) {
     print_error("Error: point counts differ: %zu in '%s', %zu in '%s'\n",
@@ -402,18 +417,20 @@ main(int argc, char** argv)
                 files[0].c_str(),
                 n_pred,
                 files[1].c_str());
-    return 1;
+    return false;
   }
   if (n == 0) {
     print_error("Error: '%s' has no points\n", files[0].c_str());
-    return 1;
+    return false;
   }
-  const std::vector<float> xyz = dacpo_tool::readTriplet(gt2, "x", "y", "z");
-  const std::vector<float> gt =
-      dacpo_tool::readTriplet(gt2, "normal_x", "normal_y", "normal_z");
-  const std::vector<float> pred =
-      dacpo_tool::readTriplet(pred2, "normal_x", "normal_y", "normal_z");
-  for (std::size_t i = 0; i < n; ++i) {
+  return true;
+}
+
+/* Every ground-truth point finite with a finite non-zero normal. */
+bool
+checkGroundTruth(const std::vector<float>& xyz, const std::vector<float>& gt)
+{
+  for (std::size_t i = 0; 3 * i < xyz.size(); ++i) {
     const float* p = &xyz[3 * i];
     const float* g = &gt[3 * i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
@@ -422,213 +439,309 @@ main(int argc, char** argv)
       print_error("Error: ground-truth point %zu has a non-finite coordinate or a "
                   "non-finite/zero normal\n",
                   i);
-      return 1;
+      return false;
     }
   }
+  return true;
+}
+
+/* The ground truth's points in a local frame (for the float k-NN search of the
+ * components); warns when the prediction's points are elsewhere. */
+std::vector<float>
+localPoints(const pcl::PCLPointCloud2& gt2, const pcl::PCLPointCloud2& pred2)
+{
   /* Same order? A reordered prediction would give a meaningless score. In
    * double: georeferenced files differ in float by the grid of their offset. */
   const std::vector<double> xyzd = dacpo_tool::readTriplet<double>(gt2, "x", "y", "z");
   const std::vector<double> pxyz =
       dacpo_tool::readTriplet<double>(pred2, "x", "y", "z");
   double max_offset = 0.0, extent = 0.0;
-  for (std::size_t i = 0; i < 3 * n; ++i) {
+  for (std::size_t i = 0; i < xyzd.size(); ++i) {
     if (std::isfinite(pxyz[i]))
       max_offset = std::max(max_offset, std::fabs(pxyz[i] - xyzd[i]));
     extent = std::max(extent, std::fabs(xyzd[i]));
   }
-  /* the k-NN components in a local frame (float search) */
   const dacpo_tool::LocalFrame frame = dacpo_tool::localFrame(xyzd);
-  std::vector<float> local(3 * n);
-  for (std::size_t i = 0; i < 3 * n; ++i)
+  std::vector<float> local(xyzd.size());
+  for (std::size_t i = 0; i < xyzd.size(); ++i)
     local[i] = static_cast<float>((xyzd[i] - frame.centre[i % 3]) / frame.scale);
   if (max_offset > 1e-4 * std::max(1.0, extent))
     print_warn(stderr,
                "Warning: predicted positions differ from the ground truth by up to "
                "%g: are the points in the same order?\n",
                max_offset);
+  return local;
+}
 
+/* What the tool reports. */
+struct EvalScores {
+  std::size_t points = 0;
+  double pct_all = 0.0;
   std::size_t wrong_all = 0;
-  const double pct_all =
-      dacpo_score_oriented(gt.data(), pred.data(), n, nullptr, &wrong_all);
+  std::size_t components = 0;
+  std::size_t largest_points = 0;
+  double pct_largest = 0.0;
+  double facing_pct = 0.0; /* right with the sign as given */
+  bool has_confidence = false;
+  double wrong_in_low10 = 0.0, low10_wrong = 0.0;
+  bool has_blocks = false;
+  BlockReport br;
+};
 
-  std::vector<std::int32_t> label;
-  const std::size_t components = componentLabels(local, label);
-  std::vector<std::size_t> sizes(components, 0);
+/* The paper metric over the largest component of label (of s.components). */
+double
+largestComponentScore(const std::vector<float>& gt,
+                      const std::vector<float>& pred,
+                      const std::vector<std::int32_t>& label,
+                      EvalScores& s)
+{
+  std::vector<std::size_t> sizes(s.components, 0);
   for (std::int32_t l : label)
     ++sizes[l];
   const std::int32_t largest = static_cast<std::int32_t>(
       std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  s.largest_points = sizes[largest];
   std::vector<float> gt_l, pred_l;
   gt_l.reserve(3 * sizes[largest]);
   pred_l.reserve(3 * sizes[largest]);
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < label.size(); ++i)
     if (label[i] == largest) {
       gt_l.insert(gt_l.end(), &gt[3 * i], &gt[3 * i + 3]);
       pred_l.insert(pred_l.end(), &pred[3 * i], &pred[3 * i + 3]);
     }
-  const double pct_largest = dacpo_score_oriented(
+  return dacpo_score_oriented(
       gt_l.data(), pred_l.data(), sizes[largest], nullptr, nullptr);
-  if (pct_all < 0.0 || pct_largest < 0.0) {
+}
+
+/* Per point under the global sign chosen for the all-points score into wrong;
+ * returns the % right without that choice (the sign the user gets). */
+double
+wrongPoints(const std::vector<float>& gt,
+            const std::vector<float>& pred,
+            std::size_t n,
+            std::vector<bool>& wrong)
+{
+  wrong.assign(n, false);
+  std::size_t wrong_pos = 0, wrong_neg = 0;
+  std::vector<double> dot(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    dot[i] = static_cast<double>(gt[3 * i]) * pred[3 * i] +
+             static_cast<double>(gt[3 * i + 1]) * pred[3 * i + 1] +
+             static_cast<double>(gt[3 * i + 2]) * pred[3 * i + 2];
+    wrong_pos += !(dot[i] > 0.0);
+    wrong_neg += !(dot[i] < 0.0);
+  }
+  const bool flip = wrong_neg < wrong_pos;
+  for (std::size_t i = 0; i < n; ++i)
+    wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
+  return n ? 100.0 * static_cast<double>(n - wrong_pos) / static_cast<double>(n) : 0.0;
+}
+
+/* With a confidence field: which share of the wrong points the least
+ * confident 10 % of the points hold (10 % if confidence says nothing). */
+void
+confidenceShares(const pcl::PCLPointCloud2& pred2,
+                 const std::vector<bool>& wrong,
+                 EvalScores& s)
+{
+  const std::size_t n = wrong.size();
+  const std::vector<float> conf = dacpo_tool::readFloatField(pred2, "confidence");
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  /* NaN (skipped points) last; ties keep the point order */
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const float x = std::isnan(conf[a]) ? 2.0f : conf[a];
+    const float y = std::isnan(conf[b]) ? 2.0f : conf[b];
+    return x < y;
+  });
+  const std::size_t low = (n + 9) / 10;
+  std::size_t wrong_total = 0, wrong_low = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    wrong_total += wrong[order[k]];
+    if (k < low)
+      wrong_low += wrong[order[k]];
+  }
+  s.wrong_in_low10 = wrong_total ? 100.0 * wrong_low / wrong_total : 0.0;
+  s.low10_wrong = low ? 100.0 * wrong_low / low : 0.0;
+}
+
+/* -normals_colored and -colored. */
+bool
+saveSideOutputs(const EvalOptions& o,
+                const pcl::PCLPointCloud2& pred2,
+                const std::vector<float>& xyz,
+                const std::vector<float>& pred,
+                const std::vector<bool>& wrong)
+{
+  if (!o.normals_colored.empty()) {
+    std::string error;
+    if (!dacpo_tool::saveCloud2(
+            o.normals_colored, dacpo_tool::normalsColored(pred2), error)) {
+      print_error("Error: %s\n", error.c_str());
+      return false;
+    }
+  }
+  if (!o.colored.empty()) {
+    if (!saveColored(o.colored, xyz, pred, wrong)) {
+      print_error("Error: cannot write '%s'\n", o.colored.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+/* The -json line. */
+void
+printJson(const std::string& file, const EvalScores& s)
+{
+  std::printf("{\"file\":%s, \"points\":%zu, \"wrong_pct\":%.4f, "
+              "\"largest_component_points\":%zu, \"largest_component_wrong_pct\":%.4f, "
+              "\"components\":%zu, \"right_sign_pct\":%.4f",
+              jsonString(file).c_str(),
+              s.points,
+              s.pct_all,
+              s.largest_points,
+              s.pct_largest,
+              s.components,
+              s.facing_pct);
+  if (s.has_confidence)
+    std::printf(", \"wrong_in_least_confident10_pct\":%.4f, "
+                "\"least_confident10_wrong_pct\":%.4f",
+                s.wrong_in_low10,
+                s.low10_wrong);
+  if (s.has_blocks) {
+    const BlockReport& br = s.br;
+    std::printf(", \"blocks\":%zu, \"component_wrong_pct\":%.4f, "
+                "\"intra_block_wrong_pct\":%.4f, \"flip_wrong_blocks\":%zu, "
+                "\"flip_wrong_points_pct\":%.4f, \"largest_block_wrong\":[",
+                br.blocks,
+                br.component_wrong_pct,
+                br.intra_block_wrong_pct,
+                br.flip_wrong_blocks,
+                br.flip_wrong_points_pct);
+    for (std::size_t k = 0; k < br.worst.size(); ++k)
+      std::printf("%s{\"id\":%d, \"component\":%d, \"points\":%zu, "
+                  "\"wrong_pct\":%.2f}",
+                  k ? ", " : "",
+                  static_cast<int>(br.worst[k].id),
+                  static_cast<int>(br.worst[k].component),
+                  br.worst[k].points,
+                  br.worst[k].wrong_pct);
+    std::printf("]");
+  }
+  std::printf("}\n");
+}
+
+/* The in-block / block-flip split of the text report. */
+void
+printBlockText(const BlockReport& br)
+{
+  print_info("  %zu blocks. Wrong with the best sign per component: ", br.blocks);
+  print_value("%.2f%%", br.component_wrong_pct);
+  print_info("; per block (in-block error, stages 2-3): ");
+  print_value("%.2f%%\n", br.intra_block_wrong_pct);
+  print_info("  Blocks flipped wrong (stages 4-5): ");
+  print_value("%zu", br.flip_wrong_blocks);
+  print_info(" of ");
+  print_value("%zu", br.blocks);
+  print_info(", holding ");
+  print_value("%.2f%%", br.flip_wrong_points_pct);
+  print_info(" of the points\n");
+  if (!br.worst.empty())
+    print_info("  Blocks with most wrong points:\n");
+  for (const BlockReport::Worst& w : br.worst) {
+    print_info("    block %5d (component %d): ",
+               static_cast<int>(w.id),
+               static_cast<int>(w.component));
+    print_value("%zu", w.points);
+    print_info(" points, ");
+    print_value("%.2f%%", w.wrong_pct);
+    print_info(" wrong\n");
+  }
+}
+
+/* The human-readable report. */
+void
+printText(const std::string& file, const EvalScores& s)
+{
+  print_info("%s: ", file.c_str());
+  print_value("%.2f%%", s.pct_all);
+  print_info(" of ");
+  print_value("%zu", s.points);
+  print_info(" points wrong (");
+  print_value("%zu", s.wrong_all);
+  print_info("); largest of ");
+  print_value("%zu", s.components);
+  print_info(" component(s): ");
+  print_value("%.2f%%", s.pct_largest);
+  print_info(" of ");
+  print_value("%zu", s.largest_points);
+  print_info(" points; with the sign as given (no global flip): ");
+  print_value("%.2f%%", s.facing_pct);
+  print_info(" right\n");
+  if (s.has_confidence) {
+    print_info("  The least confident 10%% of the points hold ");
+    print_value("%.1f%%", s.wrong_in_low10);
+    print_info(" of the wrong ones (");
+    print_value("%.1f%%", s.low10_wrong);
+    print_info(" of them are wrong)\n");
+  }
+  if (s.has_blocks)
+    printBlockText(s.br);
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  EvalOptions options;
+  int exit_code = 1;
+  if (!parseEvalOptions(argc, argv, options, exit_code))
+    return exit_code;
+  const std::vector<std::string>& files = options.files;
+
+  pcl::PCLPointCloud2 gt2, pred2;
+  EvalScores s;
+  if (!loadPair(files, gt2, pred2, s.points))
+    return 1;
+  const std::size_t n = s.points;
+  const std::vector<float> xyz = dacpo_tool::readTriplet(gt2, "x", "y", "z");
+  const std::vector<float> gt =
+      dacpo_tool::readTriplet(gt2, "normal_x", "normal_y", "normal_z");
+  const std::vector<float> pred =
+      dacpo_tool::readTriplet(pred2, "normal_x", "normal_y", "normal_z");
+  if (!checkGroundTruth(xyz, gt))
+    return 1;
+  const std::vector<float> local = localPoints(gt2, pred2);
+
+  s.pct_all = dacpo_score_oriented(gt.data(), pred.data(), n, nullptr, &s.wrong_all);
+  std::vector<std::int32_t> label;
+  s.components = componentLabels(local, label);
+  s.pct_largest = largestComponentScore(gt, pred, label, s);
+  if (s.pct_all < 0.0 || s.pct_largest < 0.0) {
     print_error("Error: scoring failed (out of memory)\n");
     return 1;
   }
+  std::vector<bool> wrong;
+  s.facing_pct = wrongPoints(gt, pred, n, wrong);
+  s.has_confidence = dacpo_tool::hasFields(pred2, {"confidence"});
+  if (s.has_confidence)
+    confidenceShares(pred2, wrong, s);
+  if (!saveSideOutputs(options, pred2, xyz, pred, wrong))
+    return 1;
 
-  /* Per point under the global sign chosen for the all-points score;
-   * facing_pct: right without that choice (the sign the user gets). */
-  std::vector<bool> wrong(n);
-  double facing_pct = 0.0;
-  {
-    std::size_t wrong_pos = 0, wrong_neg = 0;
-    std::vector<double> dot(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      dot[i] = static_cast<double>(gt[3 * i]) * pred[3 * i] +
-               static_cast<double>(gt[3 * i + 1]) * pred[3 * i + 1] +
-               static_cast<double>(gt[3 * i + 2]) * pred[3 * i + 2];
-      wrong_pos += !(dot[i] > 0.0);
-      wrong_neg += !(dot[i] < 0.0);
-    }
-    const bool flip = wrong_neg < wrong_pos;
-    facing_pct =
-        n ? 100.0 * static_cast<double>(n - wrong_pos) / static_cast<double>(n) : 0.0;
-    for (std::size_t i = 0; i < n; ++i)
-      wrong[i] = flip ? !(dot[i] < 0.0) : !(dot[i] > 0.0);
-  }
-
-  /* With a confidence field: which share of the wrong points the least
-   * confident 10 % of the points hold (10 % if confidence says nothing). */
-  const bool has_confidence = dacpo_tool::hasFields(pred2, {"confidence"});
-  double wrong_in_low10 = 0.0, low10_wrong = 0.0;
-  if (has_confidence) {
-    const std::vector<float> conf = dacpo_tool::readFloatField(pred2, "confidence");
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    /* NaN (skipped points) last; ties keep the point order */
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const float x = std::isnan(conf[a]) ? 2.0f : conf[a];
-      const float y = std::isnan(conf[b]) ? 2.0f : conf[b];
-      return x < y;
-    });
-    const std::size_t low = (n + 9) / 10;
-    std::size_t wrong_total = 0, wrong_low = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      wrong_total += wrong[order[k]];
-      if (k < low)
-        wrong_low += wrong[order[k]];
-    }
-    wrong_in_low10 = wrong_total ? 100.0 * wrong_low / wrong_total : 0.0;
-    low10_wrong = low ? 100.0 * wrong_low / low : 0.0;
-  }
-
-  if (!normals_colored.empty()) {
-    std::string error;
-    if (!dacpo_tool::saveCloud2(
-            normals_colored, dacpo_tool::normalsColored(pred2), error)) {
-      print_error("Error: %s\n", error.c_str());
-      return 1;
-    }
-  }
-  if (!colored.empty()) {
-    if (!saveColored(colored, xyz, pred, wrong)) {
-      print_error("Error: cannot write '%s'\n", colored.c_str());
-      return 1;
-    }
-  }
-
-  const bool has_blocks = dacpo_tool::hasFields(pred2, {"block"});
-  BlockReport br;
-  if (has_blocks)
-    br = blockReport(gt,
-                     pred,
-                     dacpo_tool::readInt32Field(pred2, "block"),
-                     dacpo_tool::hasFields(pred2, {"component"})
-                         ? dacpo_tool::readInt32Field(pred2, "component")
-                         : label);
-
-  if (json) {
-    std::printf(
-        "{\"file\":%s, \"points\":%zu, \"wrong_pct\":%.4f, "
-        "\"largest_component_points\":%zu, \"largest_component_wrong_pct\":%.4f, "
-        "\"components\":%zu, \"right_sign_pct\":%.4f",
-        jsonString(files[1]).c_str(),
-        n,
-        pct_all,
-        sizes[largest],
-        pct_largest,
-        components,
-        facing_pct);
-    if (has_confidence)
-      std::printf(", \"wrong_in_least_confident10_pct\":%.4f, "
-                  "\"least_confident10_wrong_pct\":%.4f",
-                  wrong_in_low10,
-                  low10_wrong);
-    if (has_blocks) {
-      std::printf(", \"blocks\":%zu, \"component_wrong_pct\":%.4f, "
-                  "\"intra_block_wrong_pct\":%.4f, \"flip_wrong_blocks\":%zu, "
-                  "\"flip_wrong_points_pct\":%.4f, \"largest_block_wrong\":[",
-                  br.blocks,
-                  br.component_wrong_pct,
-                  br.intra_block_wrong_pct,
-                  br.flip_wrong_blocks,
-                  br.flip_wrong_points_pct);
-      for (std::size_t k = 0; k < br.worst.size(); ++k)
-        std::printf("%s{\"id\":%d, \"component\":%d, \"points\":%zu, "
-                    "\"wrong_pct\":%.2f}",
-                    k ? ", " : "",
-                    static_cast<int>(br.worst[k].id),
-                    static_cast<int>(br.worst[k].component),
-                    br.worst[k].points,
-                    br.worst[k].wrong_pct);
-      std::printf("]");
-    }
-    std::printf("}\n");
-  }
-  else {
-    print_info("%s: ", files[1].c_str());
-    print_value("%.2f%%", pct_all);
-    print_info(" of ");
-    print_value("%zu", n);
-    print_info(" points wrong (");
-    print_value("%zu", wrong_all);
-    print_info("); largest of ");
-    print_value("%zu", components);
-    print_info(" component(s): ");
-    print_value("%.2f%%", pct_largest);
-    print_info(" of ");
-    print_value("%zu", sizes[largest]);
-    print_info(" points; with the sign as given (no global flip): ");
-    print_value("%.2f%%", facing_pct);
-    print_info(" right\n");
-    if (has_confidence) {
-      print_info("  The least confident 10%% of the points hold ");
-      print_value("%.1f%%", wrong_in_low10);
-      print_info(" of the wrong ones (");
-      print_value("%.1f%%", low10_wrong);
-      print_info(" of them are wrong)\n");
-    }
-    if (has_blocks) {
-      print_info("  %zu blocks. Wrong with the best sign per component: ", br.blocks);
-      print_value("%.2f%%", br.component_wrong_pct);
-      print_info("; per block (in-block error, stages 2-3): ");
-      print_value("%.2f%%\n", br.intra_block_wrong_pct);
-      print_info("  Blocks flipped wrong (stages 4-5): ");
-      print_value("%zu", br.flip_wrong_blocks);
-      print_info(" of ");
-      print_value("%zu", br.blocks);
-      print_info(", holding ");
-      print_value("%.2f%%", br.flip_wrong_points_pct);
-      print_info(" of the points\n");
-      if (!br.worst.empty())
-        print_info("  Blocks with most wrong points:\n");
-      for (const BlockReport::Worst& w : br.worst) {
-        print_info("    block %5d (component %d): ",
-                   static_cast<int>(w.id),
-                   static_cast<int>(w.component));
-        print_value("%zu", w.points);
-        print_info(" points, ");
-        print_value("%.2f%%", w.wrong_pct);
-        print_info(" wrong\n");
-      }
-    }
-  }
+  s.has_blocks = dacpo_tool::hasFields(pred2, {"block"});
+  if (s.has_blocks)
+    s.br = blockReport(gt,
+                       pred,
+                       dacpo_tool::readInt32Field(pred2, "block"),
+                       dacpo_tool::hasFields(pred2, {"component"})
+                           ? dacpo_tool::readInt32Field(pred2, "component")
+                           : label);
+  if (options.json)
+    printJson(files[1], s);
+  else
+    printText(files[1], s);
   return 0;
 }
