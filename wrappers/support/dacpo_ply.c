@@ -432,6 +432,97 @@ split_words(char* s, char** words, int max)
   return n;
 }
 
+/* A "format" line: ascii, binary_little_endian or binary_big_endian. */
+static int
+header_format(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
+{
+  if (nt < 2 || (strcmp(tok[1], "ascii") && strcmp(tok[1], "binary_little_endian") &&
+                 strcmp(tok[1], "binary_big_endian"))) {
+    ply_err(err,
+            errlen,
+            "unsupported PLY format '%s' (line %d)",
+            nt > 1 ? tok[1] : "",
+            lineno);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  h->format = strcmp(tok[1], "ascii") == 0                  ? FMT_ASCII
+              : strcmp(tok[1], "binary_little_endian") == 0 ? FMT_BLE
+                                                            : FMT_BBE;
+  return DACPO_PLY_OK;
+}
+
+/* An "element name count" line: a new element. */
+static int
+header_element(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
+{
+  ply_element* e;
+  if (nt != 3) {
+    ply_err(err, errlen, "bad element line %d", lineno);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  if (h->nel >= PLY_MAX_ELEMENTS) {
+    ply_err(err, errlen, "more than %d elements in the PLY header", PLY_MAX_ELEMENTS);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  e = &h->el[h->nel++];
+  memset(e, 0, sizeof(*e));
+  snprintf(e->name, sizeof(e->name), "%s", tok[1]);
+  if (parse_count(tok[2], &e->count) != 0) {
+    ply_err(err,
+            errlen,
+            "bad count '%s' for element '%s' (line %d)",
+            tok[2],
+            e->name,
+            lineno);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  return DACPO_PLY_OK;
+}
+
+/* A "property type name" or "property list count_type type name" line: a
+ * property of the last element. */
+static int
+header_property(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
+{
+  ply_element* e = h->nel > 0 ? &h->el[h->nel - 1] : NULL;
+  ply_prop* p;
+  if (!e) {
+    ply_err(err, errlen, "property before any element (line %d)", lineno);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  if (e->nprops >= PLY_MAX_PROPS) {
+    ply_err(
+        err, errlen, "more than %d properties in element '%s'", PLY_MAX_PROPS, e->name);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  p = &e->props[e->nprops];
+  if (nt == 5 && strcmp(tok[1], "list") == 0) {
+    p->count_type = parse_type(tok[2]);
+    p->type = parse_type(tok[3]);
+    p->role = -1;
+    if (p->count_type == T_NONE || p->count_type == T_F32 || p->count_type == T_F64 ||
+        p->type == T_NONE) {
+      ply_err(err, errlen, "bad list property types on line %d", lineno);
+      return DACPO_PLY_ERR_FORMAT;
+    }
+  }
+  else if (nt == 3) {
+    p->count_type = T_NONE;
+    p->type = parse_type(tok[1]);
+    p->role = prop_role(tok[2]);
+    if (p->type == T_NONE) {
+      ply_err(err, errlen, "unknown property type '%s' on line %d", tok[1], lineno);
+      return DACPO_PLY_ERR_FORMAT;
+    }
+  }
+  else {
+    ply_err(err, errlen, "bad property line %d", lineno);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  e->nprops++;
+  return DACPO_PLY_OK;
+}
+
 static int
 read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
 {
@@ -445,6 +536,7 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
   for (int lineno = 2; lineno < PLY_MAX_HEADER_LINES; ++lineno) {
     char* tok[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
     int nt = 0;
+    int status;
     rc = in_line(in, line, sizeof(line));
     if (rc == -1) {
       ply_err(err, errlen, "PLY header ends before 'end_header'");
@@ -471,91 +563,20 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
       return DACPO_PLY_OK;
     }
     if (strcmp(tok[0], "format") == 0) {
-      if (nt < 2 ||
-          (strcmp(tok[1], "ascii") && strcmp(tok[1], "binary_little_endian") &&
-           strcmp(tok[1], "binary_big_endian"))) {
-        ply_err(err,
-                errlen,
-                "unsupported PLY format '%s' (line %d)",
-                nt > 1 ? tok[1] : "",
-                lineno);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      h->format = strcmp(tok[1], "ascii") == 0                  ? FMT_ASCII
-                  : strcmp(tok[1], "binary_little_endian") == 0 ? FMT_BLE
-                                                                : FMT_BBE;
+      status = header_format(h, tok, nt, lineno, err, errlen);
       have_format = 1;
     }
-    else if (strcmp(tok[0], "element") == 0) {
-      ply_element* e;
-      if (nt != 3) {
-        ply_err(err, errlen, "bad element line %d", lineno);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      if (h->nel >= PLY_MAX_ELEMENTS) {
-        ply_err(
-            err, errlen, "more than %d elements in the PLY header", PLY_MAX_ELEMENTS);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      e = &h->el[h->nel++];
-      memset(e, 0, sizeof(*e));
-      snprintf(e->name, sizeof(e->name), "%s", tok[1]);
-      if (parse_count(tok[2], &e->count) != 0) {
-        ply_err(err,
-                errlen,
-                "bad count '%s' for element '%s' (line %d)",
-                tok[2],
-                e->name,
-                lineno);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-    }
-    else if (strcmp(tok[0], "property") == 0) {
-      ply_element* e = h->nel > 0 ? &h->el[h->nel - 1] : NULL;
-      ply_prop* p;
-      if (!e) {
-        ply_err(err, errlen, "property before any element (line %d)", lineno);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      if (e->nprops >= PLY_MAX_PROPS) {
-        ply_err(err,
-                errlen,
-                "more than %d properties in element '%s'",
-                PLY_MAX_PROPS,
-                e->name);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      p = &e->props[e->nprops];
-      if (nt == 5 && strcmp(tok[1], "list") == 0) {
-        p->count_type = parse_type(tok[2]);
-        p->type = parse_type(tok[3]);
-        p->role = -1;
-        if (p->count_type == T_NONE || p->count_type == T_F32 ||
-            p->count_type == T_F64 || p->type == T_NONE) {
-          ply_err(err, errlen, "bad list property types on line %d", lineno);
-          return DACPO_PLY_ERR_FORMAT;
-        }
-      }
-      else if (nt == 3) {
-        p->count_type = T_NONE;
-        p->type = parse_type(tok[1]);
-        p->role = prop_role(tok[2]);
-        if (p->type == T_NONE) {
-          ply_err(err, errlen, "unknown property type '%s' on line %d", tok[1], lineno);
-          return DACPO_PLY_ERR_FORMAT;
-        }
-      }
-      else {
-        ply_err(err, errlen, "bad property line %d", lineno);
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      e->nprops++;
-    }
+    else if (strcmp(tok[0], "element") == 0)
+      status = header_element(h, tok, nt, lineno, err, errlen);
+    else if (strcmp(tok[0], "property") == 0)
+      status = header_property(h, tok, nt, lineno, err, errlen);
     else {
       ply_err(
           err, errlen, "unknown PLY header keyword '%s' on line %d", tok[0], lineno);
-      return DACPO_PLY_ERR_FORMAT;
+      status = DACPO_PLY_ERR_FORMAT;
     }
+    if (status != DACPO_PLY_OK)
+      return status;
   }
   ply_err(err, errlen, "PLY header longer than %d lines", PLY_MAX_HEADER_LINES);
   return DACPO_PLY_ERR_FORMAT;
@@ -634,15 +655,178 @@ min_row_bytes(int format, const ply_element* e)
   return s;
 }
 
+/* The vertex element of the header, with x, y and z; *has_normals if it also
+ * has nx, ny and nz. */
+static int
+find_vertex(const ply_header* h,
+            const char* path,
+            ply_element** vert,
+            int* has_normals,
+            char* err,
+            size_t errlen)
+{
+  int has_role[6] = {0, 0, 0, 0, 0, 0};
+  *vert = NULL;
+  for (int i = 0; i < h->nel && !*vert; ++i)
+    if (strcmp(h->el[i].name, "vertex") == 0)
+      *vert = &h->el[i];
+  if (!*vert) {
+    ply_err(err, errlen, "'%s' has no 'vertex' element", path);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  for (int j = 0; j < (*vert)->nprops; ++j)
+    if ((*vert)->props[j].role >= 0)
+      has_role[(*vert)->props[j].role] = 1;
+  if (!has_role[0] || !has_role[1] || !has_role[2]) {
+    ply_err(err, errlen, "'%s': vertex element lacks x, y or z", path);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  *has_normals = has_role[3] && has_role[4] && has_role[5];
+  return DACPO_PLY_OK;
+}
+
+/* Skips the elements stored before the vertices (each checked against the
+ * bytes left of the fsize-byte file first). */
+static int
+skip_elements_before(ply_in* in,
+                     const ply_header* h,
+                     const ply_element* vert,
+                     long fsize,
+                     const char* path,
+                     char* err,
+                     size_t errlen)
+{
+  for (const ply_element* e = h->el; e != vert; ++e) {
+    double dummy[6];
+    const uint64_t left = (uint64_t)fsize - in->consumed;
+    const uint64_t row = min_row_bytes(h->format, e);
+    if (row > 0 && e->count > left / row) {
+      ply_err(err,
+              errlen,
+              "'%s' is truncated: element '%s' declares %llu rows",
+              path,
+              e->name,
+              (unsigned long long)e->count);
+      return DACPO_PLY_ERR_FORMAT;
+    }
+    for (uint64_t i = 0; i < e->count; ++i) {
+      const int rc = read_row(in, h->format, e, dummy);
+      if (rc != 0) {
+        ply_err(err,
+                errlen,
+                "'%s': %s in element '%s' row %llu",
+                path,
+                rc == -1 ? "unexpected end of file" : "bad value",
+                e->name,
+                (unsigned long long)i);
+        return DACPO_PLY_ERR_FORMAT;
+      }
+    }
+  }
+  return DACPO_PLY_OK;
+}
+
+/* The vertex count must fit in the bytes left: this rejects corrupt counts
+ * before any allocation. */
+static int
+check_vertex_count(const ply_in* in,
+                   int format,
+                   const ply_element* vert,
+                   long fsize,
+                   const char* path,
+                   char* err,
+                   size_t errlen)
+{
+  const uint64_t left = (uint64_t)fsize - in->consumed;
+  const uint64_t row = min_row_bytes(format, vert);
+  uint64_t need_ok = row == 0 ? (vert->count == 0) : (vert->count <= left / row);
+  if (format == FMT_ASCII && vert->count > 0 && row > 0)
+    need_ok = vert->count <= (left + 1) / row; /* last row may lack its newline */
+  if (!need_ok || vert->count > (uint64_t)(SIZE_MAX / (6 * sizeof(float)))) {
+    ply_err(err,
+            errlen,
+            "'%s' is truncated: header declares %llu vertices (at least %llu bytes) "
+            "but only %llu bytes of data follow",
+            path,
+            (unsigned long long)vert->count,
+            (unsigned long long)(vert->count * row),
+            (unsigned long long)left);
+    return DACPO_PLY_ERR_FORMAT;
+  }
+  return DACPO_PLY_OK;
+}
+
+/* Decodes the vertex rows into c (positions, and normals if has_normals). */
+static int
+read_vertices(ply_in* in,
+              int format,
+              const ply_element* vert,
+              int has_normals,
+              dacpo_ply_cloud* c,
+              const char* path,
+              char* err,
+              size_t errlen)
+{
+  c->n = (size_t)vert->count;
+  if (c->n > 0) {
+    c->xyz = (float*)malloc(3 * c->n * sizeof(float));
+    if (has_normals)
+      c->normals = (float*)malloc(3 * c->n * sizeof(float));
+    if (!c->xyz || (has_normals && !c->normals)) {
+      ply_err(err, errlen, "out of memory reading %zu vertices", c->n);
+      return DACPO_PLY_ERR_MEMORY;
+    }
+  }
+  for (size_t i = 0; i < c->n; ++i) {
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    const int rc = read_row(in, format, vert, v);
+    if (rc != 0) {
+      ply_err(err,
+              errlen,
+              "'%s': %s at vertex %zu of %zu",
+              path,
+              rc == -1 ? "unexpected end of file (truncated)" : "bad value",
+              i,
+              c->n);
+      return DACPO_PLY_ERR_FORMAT;
+    }
+    for (int k = 0; k < 3; ++k)
+      c->xyz[3 * i + (size_t)k] = (float)v[k];
+    if (has_normals)
+      for (int k = 0; k < 3; ++k)
+        c->normals[3 * i + (size_t)k] = (float)v[3 + k];
+  }
+  return DACPO_PLY_OK;
+}
+
+/* Opens path and finds its size (a regular file is needed for the size
+ * checks). */
+static int
+open_sized(const char* path, ply_in* in, long* fsize, char* err, size_t errlen)
+{
+  in->f = fopen(path, "rb");
+  if (!in->f) {
+    ply_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+    return DACPO_PLY_ERR_IO;
+  }
+  if (fseek(in->f, 0, SEEK_END) != 0 || (*fsize = ftell(in->f)) < 0 ||
+      fseek(in->f, 0, SEEK_SET) != 0) {
+    ply_err(
+        err, errlen, "cannot determine the size of '%s' (not a regular file?)", path);
+    fclose(in->f);
+    return DACPO_PLY_ERR_IO;
+  }
+  return DACPO_PLY_OK;
+}
+
 int
 dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
 {
   ply_in in;
   ply_header h;
   ply_element* vert = NULL;
-  int has_role[6] = {0, 0, 0, 0, 0, 0};
-  int has_normals;
-  long fsize;
+  int has_normals = 0;
+  long fsize = 0;
   int status = DACPO_PLY_OK;
   dacpo_ply_cloud c;
 
@@ -657,18 +841,9 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   memset(&in, 0, sizeof(in));
   memset(&h, 0, sizeof(h));
   memset(&c, 0, sizeof(c));
-  in.f = fopen(path, "rb");
-  if (!in.f) {
-    ply_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
-    return DACPO_PLY_ERR_IO;
-  }
-  if (fseek(in.f, 0, SEEK_END) != 0 || (fsize = ftell(in.f)) < 0 ||
-      fseek(in.f, 0, SEEK_SET) != 0) {
-    ply_err(
-        err, errlen, "cannot determine the size of '%s' (not a regular file?)", path);
-    fclose(in.f);
-    return DACPO_PLY_ERR_IO;
-  }
+  status = open_sized(path, &in, &fsize, err, errlen);
+  if (status != DACPO_PLY_OK)
+    return status;
   in.buf = (unsigned char*)malloc(PLY_BUF_SIZE);
   h.el = (ply_element*)malloc(PLY_MAX_ELEMENTS * sizeof(ply_element));
   if (!in.buf || !h.el) {
@@ -677,110 +852,18 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
     goto done;
   }
 
+  /* each step runs only if the ones before succeeded */
   status = read_header(&in, &h, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = find_vertex(&h, path, &vert, &has_normals, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = skip_elements_before(&in, &h, vert, fsize, path, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = check_vertex_count(&in, h.format, vert, fsize, path, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = read_vertices(&in, h.format, vert, has_normals, &c, path, err, errlen);
   if (status != DACPO_PLY_OK)
     goto done;
-  for (int i = 0; i < h.nel && !vert; ++i)
-    if (strcmp(h.el[i].name, "vertex") == 0)
-      vert = &h.el[i];
-  if (!vert) {
-    ply_err(err, errlen, "'%s' has no 'vertex' element", path);
-    status = DACPO_PLY_ERR_FORMAT;
-    goto done;
-  }
-  for (int j = 0; j < vert->nprops; ++j)
-    if (vert->props[j].role >= 0)
-      has_role[vert->props[j].role] = 1;
-  if (!has_role[0] || !has_role[1] || !has_role[2]) {
-    ply_err(err, errlen, "'%s': vertex element lacks x, y or z", path);
-    status = DACPO_PLY_ERR_FORMAT;
-    goto done;
-  }
-  has_normals = has_role[3] && has_role[4] && has_role[5];
-
-  /* Skip the elements stored before the vertices. */
-  for (ply_element* e = h.el; e != vert; ++e) {
-    double dummy[6];
-    const uint64_t left = (uint64_t)fsize - in.consumed;
-    const uint64_t row = min_row_bytes(h.format, e);
-    if (row > 0 && e->count > left / row) {
-      ply_err(err,
-              errlen,
-              "'%s' is truncated: element '%s' declares %llu rows",
-              path,
-              e->name,
-              (unsigned long long)e->count);
-      status = DACPO_PLY_ERR_FORMAT;
-      goto done;
-    }
-    for (uint64_t i = 0; i < e->count; ++i) {
-      const int rc = read_row(&in, h.format, e, dummy);
-      if (rc != 0) {
-        ply_err(err,
-                errlen,
-                "'%s': %s in element '%s' row %llu",
-                path,
-                rc == -1 ? "unexpected end of file" : "bad value",
-                e->name,
-                (unsigned long long)i);
-        status = DACPO_PLY_ERR_FORMAT;
-        goto done;
-      }
-    }
-  }
-
-  /* The vertex count must fit in the bytes left: this rejects corrupt counts
-   * before any allocation. */
-  {
-    const uint64_t left = (uint64_t)fsize - in.consumed;
-    const uint64_t row = min_row_bytes(h.format, vert);
-    uint64_t need_ok = row == 0 ? (vert->count == 0) : (vert->count <= left / row);
-    if (h.format == FMT_ASCII && vert->count > 0 && row > 0)
-      need_ok = vert->count <= (left + 1) / row; /* last row may lack its newline */
-    if (!need_ok || vert->count > (uint64_t)(SIZE_MAX / (6 * sizeof(float)))) {
-      ply_err(err,
-              errlen,
-              "'%s' is truncated: header declares %llu vertices (at least %llu bytes) "
-              "but only %llu bytes of data follow",
-              path,
-              (unsigned long long)vert->count,
-              (unsigned long long)(vert->count * row),
-              (unsigned long long)left);
-      status = DACPO_PLY_ERR_FORMAT;
-      goto done;
-    }
-  }
-  c.n = (size_t)vert->count;
-  if (c.n > 0) {
-    c.xyz = (float*)malloc(3 * c.n * sizeof(float));
-    if (has_normals)
-      c.normals = (float*)malloc(3 * c.n * sizeof(float));
-    if (!c.xyz || (has_normals && !c.normals)) {
-      ply_err(err, errlen, "out of memory reading %zu vertices", c.n);
-      status = DACPO_PLY_ERR_MEMORY;
-      goto done;
-    }
-  }
-  for (size_t i = 0; i < c.n; ++i) {
-    double v[6] = {0, 0, 0, 0, 0, 0};
-    const int rc = read_row(&in, h.format, vert, v);
-    if (rc != 0) {
-      ply_err(err,
-              errlen,
-              "'%s': %s at vertex %zu of %zu",
-              path,
-              rc == -1 ? "unexpected end of file (truncated)" : "bad value",
-              i,
-              c.n);
-      status = DACPO_PLY_ERR_FORMAT;
-      goto done;
-    }
-    for (int k = 0; k < 3; ++k)
-      c.xyz[3 * i + (size_t)k] = (float)v[k];
-    if (has_normals)
-      for (int k = 0; k < 3; ++k)
-        c.normals[3 * i + (size_t)k] = (float)v[3 + k];
-  }
   if (ferror(in.f)) {
     ply_err(err, errlen, "read error on '%s'", path);
     status = DACPO_PLY_ERR_IO;
