@@ -847,30 +847,12 @@ add_noise(dacpo_scene* s, double sigma, uint64_t seed)
   }
 }
 
-int
-dacpo_scene_generate(const dacpo_scene_params* params,
-                     dacpo_scene* out,
-                     char* err,
-                     size_t errlen)
+/* The parameters dacpo_scene_generate accepts (0, or SCENE_ERR_INVALID with
+ * a message). */
+static int
+check_scene_params(const dacpo_scene_params* params, char* err, size_t errlen)
 {
-  scene_builder b;
-  double* area = NULL;
-  size_t* counts = NULL;
-  quota_item* items = NULL;
-  dacpo_scene s;
-  scene_rng r;
-  size_t n, next = 0;
-  int status = 0;
-
-  if (err && errlen > 0)
-    err[0] = '\0';
-  if (out)
-    memset(out, 0, sizeof(*out));
-  if (!params || !out) {
-    set_err(
-        err, errlen, "dacpo_scene_generate: %s is NULL", !params ? "params" : "out");
-    return SCENE_ERR_INVALID;
-  }
+  const size_t n = params->target_points;
   if (params->kind >= DACPO_SCENE_KIND_COUNT) {
     set_err(err,
             errlen,
@@ -879,7 +861,6 @@ dacpo_scene_generate(const dacpo_scene_params* params,
             DACPO_SCENE_KIND_COUNT - 1);
     return SCENE_ERR_INVALID;
   }
-  n = params->target_points;
   if (n == 0 || n > SCENE_MAX_POINTS || n > SIZE_MAX / (3 * sizeof(float))) {
     set_err(
         err, errlen, "target_points %zu out of range (1..%zu)", n, SCENE_MAX_POINTS);
@@ -897,6 +878,67 @@ dacpo_scene_generate(const dacpo_scene_params* params,
             n);
     return SCENE_ERR_INVALID;
   }
+  return 0;
+}
+
+/* counts[i] points on patch i, in patch order, from the geometry stream; then
+ * the part -> object table and the object names. */
+static void
+sample_patches(const scene_builder* b,
+               const size_t* counts,
+               uint64_t seed,
+               dacpo_scene* s)
+{
+  scene_rng r;
+  size_t next = 0;
+  rng_init(&r, seed, STREAM_GEOMETRY);
+  for (size_t i = 0; i < b->count; ++i) {
+    for (size_t j = 0; j < counts[i]; ++j, ++next) {
+      double pos[3], nrm[3], len;
+      prim_sample(&b->prims[i], &r, pos, nrm);
+      len = norm3(nrm);
+      for (int k = 0; k < 3; ++k) {
+        s->xyz[3 * next + k] = (float)pos[k];
+        s->normals[3 * next + k] = (float)(nrm[k] / len);
+      }
+      s->part[next] = (int32_t)i;
+    }
+  }
+  s->n = next;
+  s->num_parts = b->count;
+  s->num_objects = b->num_objects;
+  for (size_t i = 0; i < b->count; ++i)
+    s->part_object[i] = b->prims[i].object;
+  for (size_t i = 0; i < b->num_objects; ++i)
+    s->object_name[i] = b->names[i];
+}
+
+int
+dacpo_scene_generate(const dacpo_scene_params* params,
+                     dacpo_scene* out,
+                     char* err,
+                     size_t errlen)
+{
+  scene_builder b;
+  double* area = NULL;
+  size_t* counts = NULL;
+  quota_item* items = NULL;
+  dacpo_scene s;
+  size_t n;
+  int status = 0;
+
+  if (err && errlen > 0)
+    err[0] = '\0';
+  if (out)
+    memset(out, 0, sizeof(*out));
+  if (!params || !out) {
+    set_err(
+        err, errlen, "dacpo_scene_generate: %s is NULL", !params ? "params" : "out");
+    return SCENE_ERR_INVALID;
+  }
+  if ((status = check_scene_params(params, err, errlen)) != 0)
+    return status;
+  n = params->target_points;
 
   memset(&b, 0, sizeof(b));
   memset(&s, 0, sizeof(s));
@@ -928,28 +970,7 @@ dacpo_scene_generate(const dacpo_scene_params* params,
   for (size_t i = 0; i < b.count; ++i)
     area[i] = prim_area(&b.prims[i]);
   apportion(area, b.count, n, counts, items);
-
-  rng_init(&r, params->seed, STREAM_GEOMETRY);
-  for (size_t i = 0; i < b.count; ++i) {
-    for (size_t j = 0; j < counts[i]; ++j, ++next) {
-      double pos[3], nrm[3], len;
-      prim_sample(&b.prims[i], &r, pos, nrm);
-      len = norm3(nrm);
-      for (int k = 0; k < 3; ++k) {
-        s.xyz[3 * next + k] = (float)pos[k];
-        s.normals[3 * next + k] = (float)(nrm[k] / len);
-      }
-      s.part[next] = (int32_t)i;
-    }
-  }
-  s.n = next;
-  s.num_parts = b.count;
-  s.num_objects = b.num_objects;
-  for (size_t i = 0; i < b.count; ++i)
-    s.part_object[i] = b.prims[i].object;
-  for (size_t i = 0; i < b.num_objects; ++i)
-    s.object_name[i] = b.names[i];
-
+  sample_patches(&b, counts, params->seed, &s);
   if (params->downsample_to > 0 && params->downsample_to < s.n)
     downsample(&s, params->downsample_to, params->seed);
   if (params->noise_sigma > 0.0)
