@@ -145,24 +145,69 @@ usage_error(const char* prog, const char* msg, const char* arg)
   return 1;
 }
 
-int
-main(int argc, char** argv)
-{
-  const char* prog = argc > 0 && argv[0] ? argv[0] : "dacpo_make_scene";
-  const char* out_path = NULL;
-  double offset[3] = {0.0, 0.0, 0.0}, scale = 1.0;
-  int use_offset = 0;
+/* What the command line asks for. */
+typedef struct make_options {
+  const char* out_path;
+  double offset[3], scale;
+  int use_offset; /* -offset or -scale: write double x y z */
   dacpo_scene_params p;
-  dacpo_scene scene;
-  char err[512];
-  char comment[512];
-  double t0, t1, t2;
+} make_options;
 
-  dacpo_scene_params_init(&p);
-  if (argc < 2) {
-    print_help(prog);
-    return 1;
+/* Option a with its value v (NULL if a is last). Returns 0, or the exit
+ * status after a usage error. */
+static int
+apply_option(const char* prog, const char* a, const char* v, make_options* o)
+{
+  dacpo_scene_params* p = &o->p;
+  if (strcmp(a, "-scene") && strcmp(a, "-n") && strcmp(a, "-noise") &&
+      strcmp(a, "-downsample") && strcmp(a, "-seed") && strcmp(a, "-offset") &&
+      strcmp(a, "-scale"))
+    return usage_error(prog, "unknown option", a);
+  if (!v)
+    return usage_error(prog, "missing value after", a);
+  if (strcmp(a, "-scene") == 0) {
+    if (dacpo_scene_kind_from_name(v, &p->kind) != 0)
+      return usage_error(prog, "unknown scene", v);
   }
+  else if (strcmp(a, "-n") == 0) {
+    if (parse_size(v, &p->target_points) != 0 || p->target_points == 0)
+      return usage_error(prog, "-n needs a positive integer, got", v);
+  }
+  else if (strcmp(a, "-noise") == 0) {
+    if (parse_nonneg_double(v, &p->noise_sigma) != 0)
+      return usage_error(prog, "-noise needs a finite number >= 0, got", v);
+  }
+  else if (strcmp(a, "-downsample") == 0) {
+    if (parse_size(v, &p->downsample_to) != 0)
+      return usage_error(prog, "-downsample needs an integer >= 0, got", v);
+  }
+  else if (strcmp(a, "-seed") == 0) {
+    if (parse_u64(v, &p->seed) != 0)
+      return usage_error(prog, "-seed needs an integer >= 0, got", v);
+  }
+  else if (strcmp(a, "-offset") == 0) {
+    char tail = 0;
+    double* off = o->offset;
+    if (sscanf(v, "%lf,%lf,%lf%c", &off[0], &off[1], &off[2], &tail) != 3 ||
+        !isfinite(off[0]) || !isfinite(off[1]) || !isfinite(off[2]))
+      return usage_error(prog, "-offset needs three finite numbers X,Y,Z, got", v);
+    o->use_offset = 1;
+  }
+  else if (strcmp(a, "-scale") == 0) {
+    char* end = NULL;
+    o->scale = strtod(v, &end);
+    if (end == v || *end != '\0' || !isfinite(o->scale) || !(o->scale > 0.0))
+      return usage_error(prog, "-scale needs a finite number > 0, got", v);
+    o->use_offset = 1;
+  }
+  return 0;
+}
+
+/* Reads the command line in order (help wins where it stands). Returns -1 to
+ * go on, else the exit status. */
+static int
+parse_args(int argc, char** argv, const char* prog, make_options* o)
+{
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -171,95 +216,93 @@ main(int argc, char** argv)
       return 0;
     }
     if (a[0] == '-' && a[1] != '\0') {
-      if (strcmp(a, "-scene") && strcmp(a, "-n") && strcmp(a, "-noise") &&
-          strcmp(a, "-downsample") && strcmp(a, "-seed") && strcmp(a, "-offset") &&
-          strcmp(a, "-scale"))
-        return usage_error(prog, "unknown option", a);
-      if (!v)
-        return usage_error(prog, "missing value after", a);
-      if (strcmp(a, "-scene") == 0) {
-        if (dacpo_scene_kind_from_name(v, &p.kind) != 0)
-          return usage_error(prog, "unknown scene", v);
-      }
-      else if (strcmp(a, "-n") == 0) {
-        if (parse_size(v, &p.target_points) != 0 || p.target_points == 0)
-          return usage_error(prog, "-n needs a positive integer, got", v);
-      }
-      else if (strcmp(a, "-noise") == 0) {
-        if (parse_nonneg_double(v, &p.noise_sigma) != 0)
-          return usage_error(prog, "-noise needs a finite number >= 0, got", v);
-      }
-      else if (strcmp(a, "-downsample") == 0) {
-        if (parse_size(v, &p.downsample_to) != 0)
-          return usage_error(prog, "-downsample needs an integer >= 0, got", v);
-      }
-      else if (strcmp(a, "-seed") == 0) {
-        if (parse_u64(v, &p.seed) != 0)
-          return usage_error(prog, "-seed needs an integer >= 0, got", v);
-      }
-      else if (strcmp(a, "-offset") == 0) {
-        char tail = 0;
-        if (sscanf(v, "%lf,%lf,%lf%c", &offset[0], &offset[1], &offset[2], &tail) !=
-                3 ||
-            !isfinite(offset[0]) || !isfinite(offset[1]) || !isfinite(offset[2]))
-          return usage_error(prog, "-offset needs three finite numbers X,Y,Z, got", v);
-        use_offset = 1;
-      }
-      else if (strcmp(a, "-scale") == 0) {
-        char* end = NULL;
-        scale = strtod(v, &end);
-        if (end == v || *end != '\0' || !isfinite(scale) || !(scale > 0.0))
-          return usage_error(prog, "-scale needs a finite number > 0, got", v);
-        use_offset = 1;
-      }
+      const int rc = apply_option(prog, a, v, o);
+      if (rc != 0)
+        return rc;
       ++i;
       continue;
     }
-    if (out_path)
+    if (o->out_path)
       return usage_error(prog, "more than one output file given:", a);
-    out_path = a;
+    o->out_path = a;
   }
-  if (!out_path)
+  if (!o->out_path)
     return usage_error(prog, "no output file given", NULL);
-  if (p.downsample_to > p.target_points) {
+  if (o->p.downsample_to > o->p.target_points) {
     fprintf(stderr,
             "%s: -downsample %zu is larger than -n %zu\n",
             prog,
-            p.downsample_to,
-            p.target_points);
+            o->p.downsample_to,
+            o->p.target_points);
     return 1;
   }
+  return -1;
+}
 
-  t0 = now_seconds();
-  if (dacpo_scene_generate(&p, &scene, err, sizeof(err)) != 0) {
-    fprintf(stderr, "%s: cannot generate the scene: %s\n", prog, err);
-    return 2;
-  }
-  t1 = now_seconds();
+/* Writes the scene: float PLY with the parameters as comment, or double x y z
+ * with -offset / -scale. Returns 0, or 2 after a message. */
+static int
+write_scene(const char* prog, const make_options* o, const dacpo_scene* scene)
+{
+  const dacpo_scene_params* p = &o->p;
+  char err[512] = ""; /* as left by a successful dacpo_scene_generate */
+  char comment[512];
   snprintf(comment,
            sizeof(comment),
            "GT normals: analytic (dacpo_make_scene)\n"
            "scene %s n %zu noise %g downsample %zu seed %llu",
-           dacpo_scene_kind_name(p.kind),
-           p.target_points,
-           p.noise_sigma,
-           p.downsample_to,
-           (unsigned long long)p.seed);
-  if (use_offset ? write_ply_offset(out_path,
-                                    &scene,
-                                    scale,
-                                    offset,
-                                    "moved (dacpo_make_scene -scale/-offset)") != 0
-                 : dacpo_ply_write(out_path,
-                                   scene.xyz,
-                                   scene.normals,
-                                   scene.n,
-                                   comment,
-                                   err,
-                                   sizeof(err)) != 0) {
-    if (use_offset)
-      snprintf(err, sizeof(err), "cannot write '%s': %s", out_path, strerror(errno));
+           dacpo_scene_kind_name(p->kind),
+           p->target_points,
+           p->noise_sigma,
+           p->downsample_to,
+           (unsigned long long)p->seed);
+  if (o->use_offset ? write_ply_offset(o->out_path,
+                                       scene,
+                                       o->scale,
+                                       o->offset,
+                                       "moved (dacpo_make_scene -scale/-offset)") != 0
+                    : dacpo_ply_write(o->out_path,
+                                      scene->xyz,
+                                      scene->normals,
+                                      scene->n,
+                                      comment,
+                                      err,
+                                      sizeof(err)) != 0) {
+    if (o->use_offset)
+      snprintf(err, sizeof(err), "cannot write '%s': %s", o->out_path, strerror(errno));
     fprintf(stderr, "%s: %s\n", prog, err);
+    return 2;
+  }
+  return 0;
+}
+
+int
+main(int argc, char** argv)
+{
+  const char* prog = argc > 0 && argv[0] ? argv[0] : "dacpo_make_scene";
+  make_options o;
+  dacpo_scene scene;
+  char err[512];
+  double t0, t1, t2;
+
+  memset(&o, 0, sizeof(o));
+  o.scale = 1.0;
+  dacpo_scene_params_init(&o.p);
+  if (argc < 2) {
+    print_help(prog);
+    return 1;
+  }
+  const int rc = parse_args(argc, argv, prog, &o);
+  if (rc >= 0)
+    return rc;
+
+  t0 = now_seconds();
+  if (dacpo_scene_generate(&o.p, &scene, err, sizeof(err)) != 0) {
+    fprintf(stderr, "%s: cannot generate the scene: %s\n", prog, err);
+    return 2;
+  }
+  t1 = now_seconds();
+  if (write_scene(prog, &o, &scene) != 0) {
     dacpo_scene_free(&scene);
     return 2;
   }
@@ -267,11 +310,11 @@ main(int argc, char** argv)
   printf("wrote %zu points (scene %s, %zu surface patches, noise %g, seed %llu) to %s "
          "[generate %.3f s, write %.3f s]\n",
          scene.n,
-         dacpo_scene_kind_name(p.kind),
+         dacpo_scene_kind_name(o.p.kind),
          scene.num_parts,
-         p.noise_sigma,
-         (unsigned long long)p.seed,
-         out_path,
+         o.p.noise_sigma,
+         (unsigned long long)o.p.seed,
+         o.out_path,
          t1 - t0,
          t2 - t1);
   dacpo_scene_free(&scene);
