@@ -158,6 +158,78 @@ struct CtxDeleter {
   }
 };
 
+/* The starting normals into out (3n): the given ones, or zeros with
+ * estimate_normals set when normals_in is None. */
+void
+startNormals(const FloatArray& points,
+             py::object normals_in,
+             dacpo_params& p,
+             float* out)
+{
+  const size_t n = static_cast<size_t>(points.shape(0));
+  if (normals_in.is_none()) {
+    p.estimate_normals = 1;
+    std::memset(out, 0, 3 * n * sizeof(float));
+    return;
+  }
+  FloatArray given = normals_in.cast<FloatArray>();
+  if (given.ndim() != 2 || given.shape(0) != points.shape(0) || given.shape(1) != 3)
+    throw py::value_error("normals must have the shape of points, (N, 3)");
+  std::memcpy(out, given.data(), 3 * n * sizeof(float));
+}
+
+/* The run's stats as a dict (stage times by stage name). */
+py::dict
+statsDict(const dacpo_stats* s)
+{
+  py::dict stats;
+  stats["input_points"] = s->input_points;
+  stats["unique_points"] = s->unique_points;
+  stats["duplicate_points"] = s->duplicate_points;
+  stats["k_used"] = s->k_used;
+  stats["num_components"] = s->num_components;
+  stats["num_blocks"] = s->num_blocks;
+  stats["num_block_edges"] = s->num_block_edges;
+  stats["flipped_blocks"] = s->flipped_blocks;
+  stats["solver_optimal"] = s->solver_optimal != 0;
+  stats["num_parts"] = s->num_parts;
+  stats["parts_related"] = s->parts_related;
+  stats["view_score"] = s->view_score;
+  stats["sign_flipped"] = s->sign_flipped != 0;
+  stats["sign_facing"] = s->sign_facing;
+  stats["sign_enclosed"] = s->sign_enclosed != 0;
+  stats["total_seconds"] = s->total_seconds;
+  py::dict stage_seconds;
+  for (int i = 0; i < DACPO_STAGE_COUNT; ++i)
+    stage_seconds[dacpo_stage_name(static_cast<dacpo_stage>(i))] = s->stage_seconds[i];
+  stats["stage_seconds"] = stage_seconds;
+  return stats;
+}
+
+/* Per-point labels and confidence, per-block flips into r (zeros where the
+ * run kept none). */
+void
+addLabelArrays(const dacpo_ctx* ctx, const dacpo_stats* s, py::dict& r)
+{
+  const size_t m = s->input_points;
+  auto copy_i32 = [&](const int32_t* src) {
+    py::array_t<int32_t> a(static_cast<py::ssize_t>(m));
+    if (src)
+      std::memcpy(a.mutable_data(), src, m * sizeof(int32_t));
+    return a;
+  };
+  r["component_labels"] = copy_i32(dacpo_ctx_point_components(ctx));
+  r["block_labels"] = copy_i32(dacpo_ctx_point_blocks(ctx));
+  py::array_t<float> conf(static_cast<py::ssize_t>(m));
+  if (const float* c = dacpo_ctx_point_confidence(ctx))
+    std::memcpy(conf.mutable_data(), c, m * sizeof(float));
+  r["confidence"] = conf;
+  py::array_t<uint8_t> flips(static_cast<py::ssize_t>(s->num_blocks));
+  if (const uint8_t* f = dacpo_ctx_block_flips(ctx))
+    std::memcpy(flips.mutable_data(), f, s->num_blocks);
+  r["block_flips"] = flips;
+}
+
 /* Returns a dict: status, message, and on success the arrays and stats. */
 py::dict
 orient(FloatArray points,
@@ -172,16 +244,7 @@ orient(FloatArray points,
   py::array_t<float> normals(
       {static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
   float* out = normals.mutable_data();
-  if (normals_in.is_none()) {
-    p.estimate_normals = 1;
-    std::memset(out, 0, 3 * n * sizeof(float));
-  }
-  else {
-    FloatArray given = normals_in.cast<FloatArray>();
-    if (given.ndim() != 2 || given.shape(0) != points.shape(0) || given.shape(1) != 3)
-      throw py::value_error("normals must have the shape of points, (N, 3)");
-    std::memcpy(out, given.data(), 3 * n * sizeof(float));
-  }
+  startNormals(points, normals_in, p, out);
 
   dacpo_ctx* raw = nullptr;
   if (dacpo_ctx_create(&raw) != DACPO_OK)
@@ -211,46 +274,9 @@ orient(FloatArray points,
   if (status != DACPO_OK)
     return r;
   const dacpo_stats* s = dacpo_ctx_stats(ctx.get());
-  py::dict stats;
-  stats["input_points"] = s->input_points;
-  stats["unique_points"] = s->unique_points;
-  stats["duplicate_points"] = s->duplicate_points;
-  stats["k_used"] = s->k_used;
-  stats["num_components"] = s->num_components;
-  stats["num_blocks"] = s->num_blocks;
-  stats["num_block_edges"] = s->num_block_edges;
-  stats["flipped_blocks"] = s->flipped_blocks;
-  stats["solver_optimal"] = s->solver_optimal != 0;
-  stats["num_parts"] = s->num_parts;
-  stats["parts_related"] = s->parts_related;
-  stats["view_score"] = s->view_score;
-  stats["sign_flipped"] = s->sign_flipped != 0;
-  stats["sign_facing"] = s->sign_facing;
-  stats["sign_enclosed"] = s->sign_enclosed != 0;
-  stats["total_seconds"] = s->total_seconds;
-  py::dict stage_seconds;
-  for (int i = 0; i < DACPO_STAGE_COUNT; ++i)
-    stage_seconds[dacpo_stage_name(static_cast<dacpo_stage>(i))] = s->stage_seconds[i];
-  stats["stage_seconds"] = stage_seconds;
-  r["stats"] = stats;
+  r["stats"] = statsDict(s);
   r["normals"] = normals;
-  const size_t m = s->input_points;
-  auto copy_i32 = [&](const int32_t* src) {
-    py::array_t<int32_t> a(static_cast<py::ssize_t>(m));
-    if (src)
-      std::memcpy(a.mutable_data(), src, m * sizeof(int32_t));
-    return a;
-  };
-  r["component_labels"] = copy_i32(dacpo_ctx_point_components(ctx.get()));
-  r["block_labels"] = copy_i32(dacpo_ctx_point_blocks(ctx.get()));
-  py::array_t<float> conf(static_cast<py::ssize_t>(m));
-  if (const float* c = dacpo_ctx_point_confidence(ctx.get()))
-    std::memcpy(conf.mutable_data(), c, m * sizeof(float));
-  r["confidence"] = conf;
-  py::array_t<uint8_t> flips(static_cast<py::ssize_t>(s->num_blocks));
-  if (const uint8_t* f = dacpo_ctx_block_flips(ctx.get()))
-    std::memcpy(flips.mutable_data(), f, s->num_blocks);
-  r["block_flips"] = flips;
+  addLabelArrays(ctx.get(), s, r);
   return r;
 }
 
