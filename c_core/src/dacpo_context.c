@@ -95,6 +95,7 @@ dacpo_params_init(dacpo_params* p)
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
+  p->dipole_layers = 0.0;
 }
 
 static dacpo_status
@@ -109,13 +110,10 @@ bad_field(char* message, size_t size, const char* fmt, ...)
   return DACPO_ERR_INVALID_ARGUMENT;
 }
 
-dacpo_status
-dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
+/* The k-NN graph, normals and blocks (stages 0-1). */
+static dacpo_status
+check_graph(const dacpo_params* p, char* message, size_t size)
 {
-  if (message && size > 0)
-    message[0] = '\0';
-  if (!p)
-    return bad_field(message, size, "params is NULL");
   if (p->k < 2)
     return bad_field(message,
                      size,
@@ -132,6 +130,13 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
         message, size, "num_blocks must be <= 100000 (got %zu)", p->num_blocks);
   if (p->ring_hops > 64)
     return bad_field(message, size, "ring_hops must be <= 64 (got %zu)", p->ring_hops);
+  return DACPO_OK;
+}
+
+/* Stage 2: c and the sizes of the randomized search. */
+static dacpo_status
+check_dipole_counts(const dacpo_params* p, char* message, size_t size)
+{
   if (!(p->dipole_c > 1.0) || !isfinite(p->dipole_c))
     return bad_field(message,
                      size,
@@ -150,6 +155,13 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_restarts must be in [1, 64] (got %zu)",
                      p->dipole_restarts);
+  return DACPO_OK;
+}
+
+/* Parts and the global sign. */
+static dacpo_status
+check_parts_sign(const dacpo_params* p, char* message, size_t size)
+{
   if (!(p->weak_edge_fraction >= 0.0) || !(p->weak_edge_fraction <= 1.0))
     return bad_field(message,
                      size,
@@ -165,6 +177,13 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
       !(isfinite(p->viewpoint[0]) && isfinite(p->viewpoint[1]) &&
         isfinite(p->viewpoint[2])))
     return bad_field(message, size, "viewpoint must be finite");
+  return DACPO_OK;
+}
+
+/* Sweeps, iPSR iterations, edge weights and the 0-1 solver. */
+static dacpo_status
+check_iterations_solver(const dacpo_params* p, char* message, size_t size)
+{
   if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
     return bad_field(message,
                      size,
@@ -184,6 +203,13 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
                      size,
                      "solver_time_limit must be finite and > 0 (got %g)",
                      p->solver_time_limit);
+  return DACPO_OK;
+}
+
+/* Stage 2 field rules: noise band, two sheets, layers. */
+static dacpo_status
+check_dipole_rules(const dacpo_params* p, char* message, size_t size)
+{
   if (!(p->dipole_noise_band >= 0.0) || !isfinite(p->dipole_noise_band))
     return bad_field(message,
                      size,
@@ -194,6 +220,18 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_two_sheet must be finite and >= 0 (got %g)",
                      p->dipole_two_sheet);
+  if (!(p->dipole_layers >= 0.0) || !isfinite(p->dipole_layers))
+    return bad_field(message,
+                     size,
+                     "dipole_layers must be finite and >= 0 (got %g)",
+                     p->dipole_layers);
+  return DACPO_OK;
+}
+
+/* VCR views, threads and the disconnected-part policy. */
+static dacpo_status
+check_vcr_run(const dacpo_params* p, char* message, size_t size)
+{
   if (p->vcr_image_size < 16 || p->vcr_image_size > 4096)
     return bad_field(message,
                      size,
@@ -211,6 +249,22 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
       p->disconnected != DACPO_DISCONNECTED_VIEWPOINT)
     return bad_field(
         message, size, "disconnected has an unknown value %d", (int)p->disconnected);
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
+{
+  if (message && size > 0)
+    message[0] = '\0';
+  if (!p)
+    return bad_field(message, size, "params is NULL");
+  DACPO_TRY(check_graph(p, message, size));
+  DACPO_TRY(check_dipole_counts(p, message, size));
+  DACPO_TRY(check_parts_sign(p, message, size));
+  DACPO_TRY(check_iterations_solver(p, message, size));
+  DACPO_TRY(check_dipole_rules(p, message, size));
+  DACPO_TRY(check_vcr_run(p, message, size));
   return DACPO_OK;
 }
 

@@ -24,6 +24,9 @@ typedef struct dacpo_dipole_params {
   double two_sheet;  /* 0 = off; else pairs on two sheets of one thin part
                         (offsets beyond two_sheet x local noise, see
                         dacpo_params.dipole_two_sheet) must face opposite ways */
+  double layers;     /* 0 = off; else, in a block seen from one side, parallel
+                        pairs offset by more than layers x local spacing get
+                        c = 1 (dacpo_params.dipole_layers) */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for

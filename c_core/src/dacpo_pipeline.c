@@ -229,6 +229,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.stream = (uint64_t)b;
   dp.noise_band = s->p.dipole_noise_band;
   dp.two_sheet = s->p.dipole_two_sheet;
+  dp.layers = s->p.dipole_layers;
   dp.restarts = s->p.dipole_restarts;
   double t0 = dacpo_now();
   st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);

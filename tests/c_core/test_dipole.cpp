@@ -70,6 +70,18 @@ default_params()
   return p;
 }
 
+// The pipeline's stage-2 settings (dacpo_params_init) with the layer rule off.
+dacpo_dipole_params
+pipeline_params()
+{
+  dacpo_dipole_params p = default_params();
+  p.c = 1.5;
+  p.restarts = 4;
+  p.final_sweep = 10;
+  p.two_sheet = 3.0;
+  return p;
+}
+
 // Share of points whose oriented normal matches the ground truth, up to one
 // global sign.
 double
@@ -299,6 +311,57 @@ TEST(DacpoDipole, NoisyHalfCylinderPrefersSmallC)
   p.c = 2.0;
   const double sc = orient_score(s, p);
   EXPECT_GE(sc, 0.99) << sc;
+}
+
+// Layers of one surface as a coarse depth sensor records them: `count`
+// copies of a side x side grid stacked `step` spacings apart along their common
+// axis, each shifted sideways by `shift` columns, all facing the sensor (+z).
+Shape
+stacked_layers(
+    size_t side, size_t count, double step, size_t shift, double h, uint64_t seed)
+{
+  Shape s;
+  dacpo_rng rng;
+  dacpo_rng_seed(&rng, seed, 3);
+  for (size_t l = 0; l < count; ++l)
+    for (size_t i = 0; i < side; ++i)
+      for (size_t j = 0; j < side; ++j)
+        s.add((double)(i + l * shift) * h + jitter(&rng, 0.1 * h),
+              j * h + jitter(&rng, 0.1 * h),
+              step * h * (double)l,
+              jitter(&rng, 0.01),
+              jitter(&rng, 0.01),
+              1.0);
+  s.scramble(seed);
+  return s;
+}
+
+TEST(DacpoDipole, StackedLayersOfOneSurfaceFaceOneWay)
+{
+  // Three copies of a plane 2.5 spacings apart (beyond the two-sheet window of
+  // 2 spacings; a real Kinect frame showed 3.5), shifted sideways, all facing
+  // +z. Eq. 1's stacked term says "opposite" for c > 1: measured, the layers
+  // come out alternating (2/3 right) without the layer rule. No point has a
+  // second sheet, so the block counts as seen from one side and the rule makes
+  // the layers one surface.
+  dacpo_dipole_params p = pipeline_params();
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    const Shape s = stacked_layers(30, 3, 2.5, 10, 0.01, seed);
+    p.seed = seed;
+    p.layers = 0.0;
+    EXPECT_LE(orient_score(s, p), 0.70) << seed;
+    p.layers = 0.5;
+    EXPECT_GE(orient_score(s, p), 0.999) << seed;
+  }
+}
+
+TEST(DacpoDipole, LayerRuleLeavesThinPartsOpposite)
+{
+  // Two faces of a thin board one spacing apart are two sheets, not layers:
+  // the block is two-sided, the rule stays off and the faces stay opposite.
+  dacpo_dipole_params p = pipeline_params();
+  p.layers = 0.5;
+  EXPECT_GE(orient_score(thin_board(30, 0.01, 13), p), 0.98);
 }
 
 TEST(DacpoDipole, VotingOverOrdersBeatsOneOrder)

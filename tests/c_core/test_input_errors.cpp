@@ -579,6 +579,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_noise_band", [](dacpo_params* p) { p->dipole_noise_band = -1.0; }},
       {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = -1.0; }},
       {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = std::nan(""); }},
+      {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = -0.5; }},
+      {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = HUGE_VAL; }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},
   };
   auto ctx = makeCtx();

@@ -49,6 +49,7 @@ defaultParams()
   d["disconnected"] = static_cast<int>(p.disconnected);
   d["dipole_noise_band"] = p.dipole_noise_band;
   d["dipole_two_sheet"] = p.dipole_two_sheet;
+  d["dipole_layers"] = p.dipole_layers;
   d["vcr_image_size"] = p.vcr_image_size;
   d["vcr_views"] = p.vcr_views;
   d["vcr_perspective"] = p.vcr_perspective != 0;
@@ -91,6 +92,7 @@ toParams(const py::dict& d)
       get<int>(d, "disconnected", p.disconnected));
   p.dipole_noise_band = get<double>(d, "dipole_noise_band", p.dipole_noise_band);
   p.dipole_two_sheet = get<double>(d, "dipole_two_sheet", p.dipole_two_sheet);
+  p.dipole_layers = get<double>(d, "dipole_layers", p.dipole_layers);
   p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
   p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
   p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;

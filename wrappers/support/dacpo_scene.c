@@ -894,7 +894,7 @@ sample_patches(const scene_builder* b,
   rng_init(&r, seed, STREAM_GEOMETRY);
   for (size_t i = 0; i < b->count; ++i) {
     for (size_t j = 0; j < counts[i]; ++j, ++next) {
-      double pos[3], nrm[3], len;
+      double pos[3] = {0.0, 0.0, 0.0}, nrm[3] = {0.0, 0.0, 1.0}, len;
       prim_sample(&b->prims[i], &r, pos, nrm);
       len = norm3(nrm);
       for (int k = 0; k < 3; ++k) {

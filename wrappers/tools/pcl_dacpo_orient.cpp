@@ -278,6 +278,13 @@ const OptionSpec kOptions[] = {
      "face opposite ways, 0 = off",
      showNumber<double, &dacpo_params::dipole_two_sheet>,
      setDouble<&dacpo_params::dipole_two_sheet>},
+    {"-layers",
+     "X",
+     "layered one-sided surfaces: parallel neighbours off each\n"
+     "other's tangent plane by more than X local spacings are\n"
+     "layers of one surface (no \"opposite\" vote), 0 = off",
+     showNumber<double, &dacpo_params::dipole_layers>,
+     setDouble<&dacpo_params::dipole_layers>},
     {"-orders",
      "X",
      "randomized dipole propagation orders",
