@@ -6,7 +6,8 @@
  *   sum_{(i,j) in E} omega_ij(o_i, o_j),
  * with omega(0,0) = omega(1,1) = w_same and omega(0,1) = omega(1,0) = w_diff.
  * With y_e = o_a XOR o_b this is  const + sum_e c_e y_e,  c_e = w_diff - w_same,
- * i.e. a max-cut problem. Here:
+ * i.e. a max-cut problem. Here (steps 1-2 in dacpo_ilp_graph.c, 3 in
+ * dacpo_ilp_heuristic.c, 4-5 in this file):
  *   1. parallel edges are merged (their weights add), self loops are constants;
  *   2. the edge graph is split into connected components; each is solved on its
  *      own with its lowest node fixed to 0 (a component's global sign is free),
@@ -43,9 +44,10 @@
  * lp_solve failure is not an error: the incumbent is used and optimal = 0.
  *
  * This is the only file of the project that includes lp_lib.h (it defines TRUE,
- * FALSE, LE, GE, ... as macros).
+ * FALSE, LE, GE, ... as macros); the graph and the heuristic, which need none
+ * of lp_solve, live in their own files and share dacpo_ilp_internal.h.
  */
-#include "dacpo_ilp.h"
+#include "dacpo_ilp_internal.h"
 
 #include <limits.h>
 #include <lp_lib.h>
@@ -53,12 +55,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Largest cluster grown by one cluster flip of the local search. */
-#define ILP_CLUSTER_MAX 48
-/* Cluster-flip passes over all seeds (each pass is followed by single flips). */
-#define ILP_CLUSTER_PASSES 8
-/* Random spanning trees tried after the maximum-confidence one. */
-#define ILP_TREE_RESTARTS 16
 /* Rounds of odd-cycle separation on the LP relaxation before branch and bound. */
 #define ILP_CUT_ROUNDS 20
 /* A relaxation value farther than this from 0 and 1 is fractional. */
@@ -67,715 +63,6 @@
 #define ILP_CUT_EPS 1e-4
 /* Minimum time between two progress calls from inside lp_solve (seconds). */
 #define ILP_PROGRESS_PERIOD 0.02
-
-/* ---------------------------------------------------------------------------
- * The merged edge graph and its components
- * ------------------------------------------------------------------------- */
-
-typedef struct ilp_graph {
-  size_t n; /* nodes */
-  size_t m; /* merged edges, ea < eb */
-  int32_t* ea;
-  int32_t* eb;
-  double* c;         /* w_diff - w_same: what cutting the edge (y_e = 1) gains */
-  size_t* adj_start; /* n + 1 */
-  int32_t* adj_node; /* 2m, ascending within each node */
-  int32_t* adj_edge; /* 2m, merged edge of each adjacency entry */
-  int32_t* comp;     /* component of each node */
-  size_t ncomp;
-  size_t* comp_start;  /* ncomp + 1, into comp_nodes */
-  int32_t* comp_nodes; /* ascending within a component: the lowest comes first */
-  size_t* cedge_start; /* ncomp + 1, into cedges */
-  int32_t* cedges;     /* merged edges grouped by component, ascending */
-} ilp_graph;
-
-static void
-ilp_graph_free(ilp_graph* g)
-{
-  free(g->ea);
-  free(g->eb);
-  free(g->c);
-  free(g->adj_start);
-  free(g->adj_node);
-  free(g->adj_edge);
-  free(g->comp);
-  free(g->comp_start);
-  free(g->comp_nodes);
-  free(g->cedge_start);
-  free(g->cedges);
-  memset(g, 0, sizeof(*g));
-}
-
-typedef struct ilp_pair {
-  int32_t a, b; /* a < b */
-  size_t idx;   /* input edge */
-} ilp_pair;
-
-static int
-ilp_pair_cmp(const void* pa, const void* pb)
-{
-  const ilp_pair* x = (const ilp_pair*)pa;
-  const ilp_pair* y = (const ilp_pair*)pb;
-  if (x->a != y->a)
-    return x->a < y->a ? -1 : 1;
-  if (x->b != y->b)
-    return x->b < y->b ? -1 : 1;
-  return (x->idx > y->idx) - (x->idx < y->idx);
-}
-
-/* Sorts the non-loop edges by their ends and merges parallel ones into g->ea,
- * g->eb and g->c; also allocates the remaining per-node and adjacency arrays. */
-static dacpo_status
-ilp_merge_edges(size_t num_edges,
-                const dacpo_ilp_edge* edges,
-                ilp_graph* g,
-                dacpo_err* err)
-{
-  size_t n = g->n;
-  size_t np = 0;
-  for (size_t i = 0; i < num_edges; ++i)
-    np += edges[i].a != edges[i].b;
-  ilp_pair* pairs = dacpo_malloc_array(np, sizeof(*pairs));
-  if (!pairs)
-    return DACPO_OOM(err);
-  np = 0;
-  for (size_t i = 0; i < num_edges; ++i) {
-    int32_t a = edges[i].a, b = edges[i].b;
-    if (a == b)
-      continue; /* a self loop is always "same": a constant of Eq. 8 */
-    pairs[np].a = a < b ? a : b;
-    pairs[np].b = a < b ? b : a;
-    pairs[np].idx = i;
-    ++np;
-  }
-  qsort(pairs, np, sizeof(*pairs), ilp_pair_cmp);
-  size_t m = 0;
-  for (size_t i = 0; i < np; ++i)
-    m += i == 0 || pairs[i].a != pairs[i - 1].a || pairs[i].b != pairs[i - 1].b;
-
-  g->m = m;
-  g->ea = dacpo_malloc_array(m, sizeof(int32_t));
-  g->eb = dacpo_malloc_array(m, sizeof(int32_t));
-  g->c = dacpo_calloc_array(m, sizeof(double));
-  g->adj_start = dacpo_calloc_array(n + 1, sizeof(size_t));
-  g->adj_node = dacpo_malloc_array(2 * m, sizeof(int32_t));
-  g->adj_edge = dacpo_malloc_array(2 * m, sizeof(int32_t));
-  g->comp = dacpo_malloc_array(n, sizeof(int32_t));
-  if (!g->ea || !g->eb || !g->c || !g->adj_start || !g->adj_node || !g->adj_edge ||
-      !g->comp) {
-    free(pairs);
-    return DACPO_OOM(err);
-  }
-  size_t e = 0;
-  for (size_t i = 0; i < np; ++i) {
-    if (i > 0 && (pairs[i].a != pairs[i - 1].a || pairs[i].b != pairs[i - 1].b))
-      ++e;
-    const dacpo_ilp_edge* in = &edges[pairs[i].idx];
-    g->ea[e] = pairs[i].a;
-    g->eb[e] = pairs[i].b;
-    g->c[e] += in->w_diff - in->w_same; /* parallel edges add up in Eq. 8 */
-  }
-  free(pairs);
-  return DACPO_OK;
-}
-
-/* CSR adjacency. Filling in (a, b) order leaves every list ascending: the
- * smaller neighbours of v come from edges (x, v), x < v, which sort before the
- * edges (v, y). The intersection of triangle enumeration relies on it.
- * fill: n + 1 scratch entries. */
-static void
-ilp_fill_adjacency(ilp_graph* g, size_t* fill)
-{
-  size_t n = g->n, m = g->m;
-  for (size_t k = 0; k < m; ++k) {
-    g->adj_start[g->ea[k] + 1]++;
-    g->adj_start[g->eb[k] + 1]++;
-  }
-  for (size_t v = 0; v < n; ++v)
-    g->adj_start[v + 1] += g->adj_start[v];
-  memcpy(fill, g->adj_start, (n + 1) * sizeof(size_t));
-  for (size_t k = 0; k < m; ++k) {
-    int32_t a = g->ea[k], b = g->eb[k];
-    g->adj_node[fill[a]] = b;
-    g->adj_edge[fill[a]++] = (int32_t)k;
-    g->adj_node[fill[b]] = a;
-    g->adj_edge[fill[b]++] = (int32_t)k;
-  }
-}
-
-/* Components by BFS from the lowest unvisited node; queue: n scratch entries.
- * Sets g->comp and g->ncomp. */
-static void
-ilp_label_components(ilp_graph* g, size_t* queue)
-{
-  size_t n = g->n;
-  for (size_t v = 0; v < n; ++v)
-    g->comp[v] = -1;
-  size_t ncomp = 0;
-  for (size_t s = 0; s < n; ++s) {
-    if (g->comp[s] >= 0)
-      continue;
-    size_t head = 0, tail = 0;
-    queue[tail++] = s;
-    g->comp[s] = (int32_t)ncomp;
-    while (head < tail) {
-      size_t v = queue[head++];
-      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
-        int32_t u = g->adj_node[q];
-        if (g->comp[u] < 0) {
-          g->comp[u] = (int32_t)ncomp;
-          queue[tail++] = (size_t)u;
-        }
-      }
-    }
-    ++ncomp;
-  }
-  g->ncomp = ncomp;
-}
-
-/* Groups nodes and edges by component. Counting sorts keep them ascending
- * inside each component. */
-static dacpo_status
-ilp_group_components(ilp_graph* g, dacpo_err* err)
-{
-  size_t n = g->n, m = g->m, ncomp = g->ncomp;
-  g->comp_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
-  g->comp_nodes = dacpo_malloc_array(n, sizeof(int32_t));
-  g->cedge_start = dacpo_calloc_array(ncomp + 1, sizeof(size_t));
-  g->cedges = dacpo_malloc_array(m, sizeof(int32_t));
-  size_t* cfill = dacpo_malloc_array(ncomp + 1, sizeof(size_t));
-  if (!g->comp_start || !g->comp_nodes || !g->cedge_start || !g->cedges || !cfill) {
-    free(cfill);
-    return DACPO_OOM(err);
-  }
-  for (size_t v = 0; v < n; ++v)
-    g->comp_start[g->comp[v] + 1]++;
-  for (size_t c = 0; c < ncomp; ++c)
-    g->comp_start[c + 1] += g->comp_start[c];
-  memcpy(cfill, g->comp_start, (ncomp + 1) * sizeof(size_t));
-  for (size_t v = 0; v < n; ++v)
-    g->comp_nodes[cfill[g->comp[v]]++] = (int32_t)v;
-  for (size_t k = 0; k < m; ++k)
-    g->cedge_start[g->comp[g->ea[k]] + 1]++;
-  for (size_t c = 0; c < ncomp; ++c)
-    g->cedge_start[c + 1] += g->cedge_start[c];
-  memcpy(cfill, g->cedge_start, (ncomp + 1) * sizeof(size_t));
-  for (size_t k = 0; k < m; ++k)
-    g->cedges[cfill[g->comp[g->ea[k]]]++] = (int32_t)k;
-  free(cfill);
-  return DACPO_OK;
-}
-
-static dacpo_status
-ilp_graph_build(size_t n,
-                size_t num_edges,
-                const dacpo_ilp_edge* edges,
-                ilp_graph* g,
-                dacpo_err* err)
-{
-  memset(g, 0, sizeof(*g));
-  g->n = n;
-  dacpo_status st = ilp_merge_edges(num_edges, edges, g, err);
-  if (st != DACPO_OK) {
-    ilp_graph_free(g);
-    return st;
-  }
-  size_t* fill = dacpo_malloc_array(n + 1, sizeof(size_t));
-  if (!fill) {
-    ilp_graph_free(g);
-    return DACPO_OOM(err);
-  }
-  ilp_fill_adjacency(g, fill);
-  ilp_label_components(g, fill); /* the fill pointers are done: reused as queue */
-  free(fill);
-  st = ilp_group_components(g, err);
-  if (st != DACPO_OK)
-    ilp_graph_free(g);
-  return st;
-}
-
-/* sum over a component's edges of c_e y_e (Eq. 8 without its constant) */
-static double
-ilp_comp_value(const ilp_graph* g, size_t ci, const uint8_t* o)
-{
-  double s = 0.0;
-  for (size_t q = g->cedge_start[ci]; q < g->cedge_start[ci + 1]; ++q) {
-    int32_t e = g->cedges[q];
-    if (o[g->ea[e]] != o[g->eb[e]])
-      s += g->c[e];
-  }
-  return s;
-}
-
-/* ---------------------------------------------------------------------------
- * Heuristic incumbent: maximum-confidence spanning tree + local search
- * ------------------------------------------------------------------------- */
-
-typedef struct ilp_key {
-  double key;
-  int32_t e;
-} ilp_key;
-
-static int
-ilp_key_desc(const void* pa, const void* pb)
-{
-  const ilp_key* x = (const ilp_key*)pa;
-  const ilp_key* y = (const ilp_key*)pb;
-  if (x->key != y->key)
-    return x->key > y->key ? -1 : 1;
-  return (x->e > y->e) - (x->e < y->e);
-}
-
-/* The term of edge e in the gain of flipping one of its ends. */
-static double
-ilp_term(const ilp_graph* g, const uint8_t* o, int32_t e)
-{
-  return (o[g->ea[e]] != o[g->eb[e]]) ? -g->c[e] : g->c[e];
-}
-
-/* Flips node v and keeps gain[] (objective change of flipping each node) exact. */
-static void
-ilp_flip_node(const ilp_graph* g, uint8_t* o, double* gain, int32_t v)
-{
-  for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
-    int32_t u = g->adj_node[q];
-    gain[u] -= 2.0 * ilp_term(g, o, g->adj_edge[q]);
-  }
-  gain[v] = -gain[v];
-  o[v] ^= 1u;
-}
-
-/* Flips the single node of best positive gain until none is left. */
-static void
-ilp_single_flips(const ilp_graph* g, uint8_t* o, double* gain, double tol)
-{
-  size_t limit = 16 * g->n + 64; /* each flip gains > tol; this only guards rounding */
-  for (size_t it = 0; it < limit; ++it) {
-    int32_t best = -1;
-    double bg = tol;
-    for (size_t v = 0; v < g->n; ++v)
-      if (gain[v] > bg) {
-        bg = gain[v];
-        best = (int32_t)v;
-      }
-    if (best < 0)
-      return;
-    ilp_flip_node(g, o, gain, best);
-  }
-}
-
-typedef struct ilp_cluster_ws {
-  uint8_t* in_s;    /* node is in the cluster */
-  uint8_t* in_f;    /* node is on the frontier */
-  double* inner;    /* sum of terms of edges from the node into the cluster */
-  int32_t* members; /* cluster in growth order */
-  int32_t* frontier;
-  int32_t* touched; /* nodes whose in_f / inner must be reset */
-} ilp_cluster_ws;
-
-/* Grows a connected cluster from seed s, each step adding the frontier node
- * that raises the cluster's flip gain most, and flips the best prefix if it
- * gains. Flipping S changes exactly the edges leaving S; adding v to S turns
- * its edges into S from cut-changing to internal: delta = gain[v] - 2 inner[v]. */
-static int
-ilp_grow_cluster(const ilp_graph* g,
-                 uint8_t* o,
-                 double* gain,
-                 ilp_cluster_ws* w,
-                 int32_t s,
-                 double tol)
-{
-  size_t ns = 0, nf = 0, nt = 0;
-  double cur = 0.0, best = tol;
-  size_t bestk = 0;
-  int32_t v = s;
-  double delta = gain[s];
-  for (;;) {
-    cur += delta;
-    w->in_s[v] = 1;
-    w->members[ns++] = v;
-    if (cur > best) {
-      best = cur;
-      bestk = ns;
-    }
-    for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
-      int32_t u = g->adj_node[q];
-      if (w->in_s[u])
-        continue;
-      if (!w->in_f[u]) {
-        w->in_f[u] = 1;
-        w->inner[u] = 0.0;
-        w->frontier[nf++] = u;
-        w->touched[nt++] = u;
-      }
-      w->inner[u] += ilp_term(g, o, g->adj_edge[q]);
-    }
-    if (ns >= ILP_CLUSTER_MAX || nf == 0)
-      break;
-    size_t bi = 0;
-    double bd = -INFINITY;
-    for (size_t i = 0; i < nf; ++i) {
-      double d = gain[w->frontier[i]] - 2.0 * w->inner[w->frontier[i]];
-      if (d > bd) {
-        bd = d;
-        bi = i;
-      }
-    }
-    v = w->frontier[bi];
-    delta = bd;
-    w->frontier[bi] = w->frontier[--nf];
-    w->in_f[v] = 0;
-  }
-  for (size_t i = 0; i < nt; ++i)
-    w->in_f[w->touched[i]] = 0;
-  for (size_t i = 0; i < ns; ++i)
-    w->in_s[w->members[i]] = 0;
-  for (size_t i = 0; i < bestk; ++i)
-    ilp_flip_node(g, o, gain, w->members[i]);
-  return bestk > 0;
-}
-
-/* The maximum-confidence spanning forest, rooted at each component's lowest
- * node, in preorder (a subtree is a contiguous range of order[]). */
-typedef struct ilp_tree {
-  int32_t* order;  /* preorder of all nodes, component by component */
-  int32_t* pos;    /* node -> index in order */
-  int32_t* size;   /* subtree size */
-  int32_t* parent; /* -1 at roots */
-  int32_t* pedge;  /* edge to the parent, -1 at roots */
-  int32_t* depth;
-  int32_t* lca; /* per merged edge: lowest common ancestor of its ends */
-  double* acc;  /* scratch: subtree-gain accumulation */
-} ilp_tree;
-
-static void
-ilp_tree_free(ilp_tree* t)
-{
-  free(t->order);
-  free(t->pos);
-  free(t->size);
-  free(t->parent);
-  free(t->pedge);
-  free(t->depth);
-  free(t->lca);
-  free(t->acc);
-}
-
-/* Kruskal on |c_e| (with rng, on |c_e| times a uniform random factor, for the
- * restarts): marks the edges of the maximum spanning forest in in_tree. */
-static void
-ilp_spanning_forest(
-    const ilp_graph* g, dacpo_rng* rng, ilp_key* keys, int32_t* uf, uint8_t* in_tree)
-{
-  size_t n = g->n, m = g->m;
-  for (size_t k = 0; k < m; ++k) {
-    keys[k].key = fabs(g->c[k]) * (rng ? dacpo_rng_uniform(rng) : 1.0);
-    keys[k].e = (int32_t)k;
-  }
-  qsort(keys, m, sizeof(*keys), ilp_key_desc);
-  for (size_t v = 0; v < n; ++v)
-    uf[v] = (int32_t)v;
-  for (size_t k = 0; k < m; ++k) {
-    int32_t e = keys[k].e;
-    if (dacpo_uf_find(uf, g->ea[e]) == dacpo_uf_find(uf, g->eb[e]))
-      continue;
-    dacpo_uf_union(uf, g->ea[e], g->eb[e]);
-    in_tree[e] = 1;
-  }
-}
-
-/* Iterative DFS preorder of the forest from each component's lowest node, with
- * parents, parent edges, depths and subtree sizes. stack: n scratch entries. */
-static void
-ilp_forest_preorder(const ilp_graph* g,
-                    const uint8_t* in_tree,
-                    int32_t* stack,
-                    ilp_tree* t)
-{
-  size_t n = g->n;
-  for (size_t v = 0; v < n; ++v)
-    t->pos[v] = -1;
-  size_t no = 0;
-  for (size_t ci = 0; ci < g->ncomp; ++ci) {
-    int32_t root = g->comp_nodes[g->comp_start[ci]];
-    size_t sp = 0;
-    stack[sp++] = root;
-    t->parent[root] = -1;
-    t->pedge[root] = -1;
-    t->depth[root] = 0;
-    while (sp > 0) {
-      int32_t v = stack[--sp];
-      t->pos[v] = (int32_t)no;
-      t->order[no++] = v;
-      for (size_t q = g->adj_start[v]; q < g->adj_start[v + 1]; ++q) {
-        int32_t u = g->adj_node[q], e = g->adj_edge[q];
-        if (!in_tree[e] || u == t->parent[v])
-          continue;
-        t->parent[u] = v;
-        t->pedge[u] = e;
-        t->depth[u] = t->depth[v] + 1;
-        stack[sp++] = u;
-      }
-    }
-  }
-  for (size_t i = n; i-- > 0;) {
-    int32_t v = t->order[i];
-    t->size[v] = 1;
-  }
-  for (size_t i = n; i-- > 0;) {
-    int32_t v = t->order[i];
-    if (t->parent[v] >= 0)
-      t->size[t->parent[v]] += t->size[v];
-  }
-}
-
-/* The LCA of every edge's ends by binary lifting: up[l * n + v] (levels * n
- * scratch entries) is the 2^l-th ancestor (roots map to self). */
-static void
-ilp_edge_lcas(const ilp_graph* g, size_t levels, int32_t* up, ilp_tree* t)
-{
-  size_t n = g->n, m = g->m;
-  for (size_t v = 0; v < n; ++v)
-    up[v] = t->parent[v] >= 0 ? t->parent[v] : (int32_t)v;
-  for (size_t l = 1; l < levels; ++l)
-    for (size_t v = 0; v < n; ++v)
-      up[l * n + v] = up[(l - 1) * n + up[(l - 1) * n + v]];
-  for (size_t k = 0; k < m; ++k) {
-    int32_t a = g->ea[k], b = g->eb[k];
-    if (t->depth[a] < t->depth[b]) {
-      int32_t x = a;
-      a = b;
-      b = x;
-    }
-    int32_t diff = t->depth[a] - t->depth[b];
-    for (size_t l = 0; l < levels; ++l)
-      if (diff & (1 << l))
-        a = up[l * n + a];
-    if (a != b) {
-      for (size_t l = levels; l-- > 0;)
-        if (up[l * n + a] != up[l * n + b]) {
-          a = up[l * n + a];
-          b = up[l * n + b];
-        }
-      a = up[a];
-    }
-    t->lca[k] = a;
-  }
-}
-
-/* Kruskal on |c_e| (the most confident edges decide the relative flips; with
- * rng, on |c_e| times a uniform random factor, for the restarts), a preorder of
- * the forest, and the LCA of every edge's ends by binary lifting. */
-static dacpo_status
-ilp_tree_build(const ilp_graph* g, dacpo_rng* rng, ilp_tree* t, dacpo_err* err)
-{
-  size_t n = g->n, m = g->m;
-  dacpo_status st = DACPO_OK;
-  memset(t, 0, sizeof(*t));
-  t->order = dacpo_malloc_array(n, sizeof(int32_t));
-  t->pos = dacpo_malloc_array(n, sizeof(int32_t));
-  t->size = dacpo_malloc_array(n, sizeof(int32_t));
-  t->parent = dacpo_malloc_array(n, sizeof(int32_t));
-  t->pedge = dacpo_malloc_array(n, sizeof(int32_t));
-  t->depth = dacpo_malloc_array(n, sizeof(int32_t));
-  t->lca = dacpo_malloc_array(m, sizeof(int32_t));
-  t->acc = dacpo_malloc_array(n, sizeof(double));
-  ilp_key* keys = dacpo_malloc_array(m, sizeof(*keys));
-  int32_t* uf = dacpo_malloc_array(n, sizeof(int32_t));
-  uint8_t* in_tree = dacpo_calloc_array(m, 1);
-  int32_t* stack = dacpo_malloc_array(n, sizeof(int32_t));
-  size_t levels = 1;
-  while (levels < 31 && ((size_t)1 << levels) < n)
-    ++levels;
-  int32_t* up = dacpo_malloc_array(n, levels * sizeof(int32_t));
-  if (!t->order || !t->pos || !t->size || !t->parent || !t->pedge || !t->depth ||
-      !t->lca || !t->acc || !keys || !uf || !in_tree || !stack || !up) {
-    st = DACPO_OOM(err);
-    goto done;
-  }
-  ilp_spanning_forest(g, rng, keys, uf, in_tree);
-  ilp_forest_preorder(g, in_tree, stack, t);
-  ilp_edge_lcas(g, levels, up, t);
-done:
-  free(keys);
-  free(uf);
-  free(in_tree);
-  free(stack);
-  free(up);
-  if (st != DACPO_OK) {
-    ilp_tree_free(t);
-    memset(t, 0, sizeof(*t));
-  }
-  return st;
-}
-
-/* Subtree moves: flipping the subtree under v changes exactly the edges with
- * one end inside, i.e. the edges whose tree path passes the parent edge of v.
- * Adding each edge's term at both ends and -2x at their LCA, subtree sums give
- * every subtree's gain in O(n + m); the best is flipped until none gains. This
- * undoes a noisy but confident edge that the spanning tree trusted. */
-static int
-ilp_subtree_moves(
-    const ilp_graph* g, const ilp_tree* t, uint8_t* o, double* gain, double tol)
-{
-  int improved = 0;
-  for (size_t it = 0; it < g->n; ++it) {
-    memset(t->acc, 0, g->n * sizeof(double));
-    for (size_t k = 0; k < g->m; ++k) {
-      double x = ilp_term(g, o, (int32_t)k);
-      t->acc[g->ea[k]] += x;
-      t->acc[g->eb[k]] += x;
-      t->acc[t->lca[k]] -= 2.0 * x;
-    }
-    int32_t best = -1;
-    double bg = tol;
-    for (size_t i = g->n; i-- > 0;) {
-      int32_t v = t->order[i];
-      if (t->parent[v] < 0)
-        continue;
-      if (t->acc[v] > bg) {
-        bg = t->acc[v];
-        best = v;
-      }
-      t->acc[t->parent[v]] += t->acc[v];
-    }
-    if (best < 0)
-      break;
-    for (int32_t i = t->pos[best]; i < t->pos[best] + t->size[best]; ++i)
-      ilp_flip_node(g, o, gain, t->order[i]);
-    improved = 1;
-  }
-  return improved;
-}
-
-/* Subtree, single and cluster moves until none gains (or the pass limit). */
-static void
-ilp_descend(const ilp_graph* g,
-            const ilp_tree* t,
-            ilp_cluster_ws* w,
-            uint8_t* o,
-            double* gain,
-            double tol)
-{
-  for (int pass = 0; pass < ILP_CLUSTER_PASSES; ++pass) {
-    int improved = ilp_subtree_moves(g, t, o, gain, tol);
-    ilp_single_flips(g, o, gain, tol);
-    if (w) {
-      /* A cluster can only gain across an unsatisfied edge (term > 0), so
-       * seeds are the ends of unsatisfied edges. */
-      for (size_t s = 0; s < g->n; ++s) {
-        int seed = 0;
-        for (size_t q = g->adj_start[s]; q < g->adj_start[s + 1] && !seed; ++q)
-          seed = ilp_term(g, o, g->adj_edge[q]) > 0.0;
-        if (seed)
-          improved |= ilp_grow_cluster(g, o, gain, w, (int32_t)s, tol);
-      }
-      ilp_single_flips(g, o, gain, tol);
-    }
-    if (!improved)
-      break;
-  }
-}
-
-/* Flips along the tree (each tree edge at its preferred value), gains, then
- * local search. */
-static void
-ilp_start(const ilp_graph* g,
-          const ilp_tree* t,
-          ilp_cluster_ws* w,
-          uint8_t* o,
-          double* gain,
-          double tol)
-{
-  for (size_t i = 0; i < g->n; ++i) {
-    int32_t v = t->order[i];
-    o[v] =
-        t->parent[v] < 0 ? 0 : (uint8_t)(o[t->parent[v]] ^ (g->c[t->pedge[v]] > 0.0));
-  }
-  memset(gain, 0, g->n * sizeof(double));
-  for (size_t k = 0; k < g->m; ++k) {
-    double x = ilp_term(g, o, (int32_t)k);
-    gain[g->ea[k]] += x;
-    gain[g->eb[k]] += x;
-  }
-  ilp_descend(g, t, w, o, gain, tol);
-}
-
-/* The incumbent: the maximum-confidence tree, then restarts from random
- * spanning trees (each a different basin for the local search; measured on the
- * bench graphs, 16 restarts reached lp_solve's optimum where the single start
- * stalled ~1 % below it). Restarts stop at stop_time, so a tiny time limit still
- * gets the first answer. o gets the best; each component's lowest node is 0. */
-static dacpo_status
-ilp_heuristic(const ilp_graph* g, double stop_time, uint8_t* o, dacpo_err* err)
-{
-  size_t n = g->n, m = g->m;
-  dacpo_status st = DACPO_OK;
-  ilp_tree t;
-  DACPO_TRY(ilp_tree_build(g, NULL, &t, err));
-  double* gain = dacpo_malloc_array(n, sizeof(double));
-  uint8_t* o2 = dacpo_malloc_array(n, 1);
-  double* best = dacpo_malloc_array(g->ncomp, sizeof(double));
-  ilp_cluster_ws w;
-  w.in_s = dacpo_calloc_array(n, 1);
-  w.in_f = dacpo_calloc_array(n, 1);
-  w.inner = dacpo_calloc_array(n, sizeof(double));
-  w.members = dacpo_malloc_array(n, sizeof(int32_t));
-  w.frontier = dacpo_malloc_array(n, sizeof(int32_t));
-  w.touched = dacpo_malloc_array(n, sizeof(int32_t));
-  if (!gain || !o2 || !best || !w.in_s || !w.in_f || !w.inner || !w.members ||
-      !w.frontier || !w.touched) {
-    st = DACPO_OOM(err);
-    goto done;
-  }
-  /* tol is relative to the weights, so rounding cannot make moves cycle */
-  double scale = 0.0;
-  for (size_t k = 0; k < m; ++k)
-    scale += fabs(g->c[k]);
-  double tol = 1e-12 * (1.0 + scale);
-
-  ilp_start(g, &t, &w, o, gain, tol);
-  for (size_t ci = 0; ci < g->ncomp; ++ci)
-    best[ci] = ilp_comp_value(g, ci, o);
-  dacpo_rng rng;
-  dacpo_rng_seed(&rng, 0x1d3c5a7ull, (uint64_t)n);
-  /* A forest (m = n - components) is solved exactly by the first tree. Each
-   * component keeps its best restart: their relative sign does not matter. */
-  for (int r = 0; r < ILP_TREE_RESTARTS && m + g->ncomp > n && dacpo_now() < stop_time;
-       ++r) {
-    ilp_tree_free(&t);
-    st = ilp_tree_build(g, &rng, &t, err);
-    if (st != DACPO_OK)
-      goto done;
-    ilp_start(g, &t, &w, o2, gain, tol);
-    for (size_t ci = 0; ci < g->ncomp; ++ci) {
-      double v = ilp_comp_value(g, ci, o2);
-      if (v > best[ci] + tol) {
-        best[ci] = v;
-        for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
-          o[g->comp_nodes[q]] = o2[g->comp_nodes[q]];
-      }
-    }
-  }
-  /* A component's lowest node is the fixed reference (o = 0). */
-  for (size_t ci = 0; ci < g->ncomp; ++ci)
-    if (o[g->comp_nodes[g->comp_start[ci]]])
-      for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
-        o[g->comp_nodes[q]] ^= 1u;
-
-done:
-  ilp_tree_free(&t);
-  free(gain);
-  free(o2);
-  free(best);
-  free(w.in_s);
-  free(w.in_f);
-  free(w.inner);
-  free(w.members);
-  free(w.frontier);
-  free(w.touched);
-  return st;
-}
 
 /* ---------------------------------------------------------------------------
  * lp_solve
@@ -929,7 +216,7 @@ ilp_heap_down(int32_t* heap, int32_t* pos, const double* key, size_t size, size_
  * n0.., from src = (s, 0); stops at dst = (s, 1) or once every distance left is
  * >= 1 (no violated inequality beyond). y: edge values, local edge order. */
 static void
-ilp_parity_dijkstra(const ilp_graph* g,
+ilp_parity_dijkstra(const dacpo_ilp_graph* g,
                     size_t n0,
                     size_t nn,
                     ilp_lp_ws* w,
@@ -986,8 +273,12 @@ ilp_parity_dijkstra(const ilp_graph* g,
  * negated where the parity switches). Sets *len and *nf (switching edges).
  * Returns 0 as soon as a node repeats: only simple cycles are kept. */
 static int
-ilp_walk_cycle(
-    const ilp_graph* g, size_t n0, ilp_lp_ws* w, int32_t s, size_t* len, size_t* nf)
+ilp_walk_cycle(const dacpo_ilp_graph* g,
+               size_t n0,
+               ilp_lp_ws* w,
+               int32_t s,
+               size_t* len,
+               size_t* nf)
 {
   int32_t src = 2 * w->loc[s], dst = src + 1;
   *len = 0;
@@ -1039,7 +330,7 @@ ilp_cycle_key(const int32_t* cyc_e, size_t len)
  * inequality. Only simple cycles of length >= 4 are added (triangles are rows
  * already). Returns the number of cuts added, or -1 if lp_solve refused a row. */
 static long
-ilp_separate(const ilp_graph* g,
+ilp_separate(const dacpo_ilp_graph* g,
              size_t ci,
              lprec* lp,
              ilp_lp_ws* w,
@@ -1087,7 +378,8 @@ ilp_separate(const ilp_graph* g,
 /* Reads o for the component from lp_solve's variables (rounded; the fixed node
  * stays 0). Returns 1 if every node and edge value was integral. */
 static int
-ilp_read_flips(const ilp_graph* g, size_t ci, const double* vars, int ncols, uint8_t* o)
+ilp_read_flips(
+    const dacpo_ilp_graph* g, size_t ci, const double* vars, int ncols, uint8_t* o)
 {
   int integral = 1;
   for (int j = 0; j < ncols; ++j)
@@ -1108,7 +400,8 @@ typedef struct ilp_comp_out {
 /* lp_solve's objective: max sum c_e y_e over the component's edges (columns
  * nc+1..nc+mc), normalized to max |c| = 1. Returns lp_solve's ok. */
 static int
-ilp_lp_objective(const ilp_graph* g, size_t ci, size_t nc, lprec* lp, ilp_lp_ws* w)
+ilp_lp_objective(
+    const dacpo_ilp_graph* g, size_t ci, size_t nc, lprec* lp, ilp_lp_ws* w)
 {
   size_t e0 = g->cedge_start[ci], mc = g->cedge_start[ci + 1] - e0;
   double cmax = 0.0;
@@ -1125,7 +418,7 @@ ilp_lp_objective(const ilp_graph* g, size_t ci, size_t nc, lprec* lp, ilp_lp_ws*
 
 /* The four XOR rows of every edge of the component. Returns lp_solve's ok. */
 static int
-ilp_lp_xor_rows(const ilp_graph* g,
+ilp_lp_xor_rows(const dacpo_ilp_graph* g,
                 size_t ci,
                 size_t nc,
                 lprec* lp,
@@ -1146,7 +439,7 @@ ilp_lp_xor_rows(const ilp_graph* g,
  * above b, so each 3-cycle is found once, from its lowest edge. Returns 0 if
  * lp_solve refused a row or the deadline passed (then ab->timed_out is set). */
 static int
-ilp_lp_triangle_rows(const ilp_graph* g,
+ilp_lp_triangle_rows(const dacpo_ilp_graph* g,
                      size_t ci,
                      size_t nc,
                      lprec* lp,
@@ -1197,7 +490,7 @@ ilp_lp_triangle_rows(const ilp_graph* g,
  * relaxation bound the incumbent reaches proves the incumbent optimal
  * (out->incumbent_optimal). *ok drops to 0 if lp_solve refused a cut. */
 static int
-ilp_cut_rounds(const ilp_graph* g,
+ilp_cut_rounds(const dacpo_ilp_graph* g,
                size_t ci,
                lprec* lp,
                ilp_lp_ws* w,
@@ -1249,7 +542,7 @@ ilp_cut_rounds(const ilp_graph* g,
 /* Branch and bound on the strengthened model; on a usable answer o holds it
  * and out->have / out->proven are set. */
 static void
-ilp_branch_and_bound(const ilp_graph* g,
+ilp_branch_and_bound(const dacpo_ilp_graph* g,
                      size_t ci,
                      lprec* lp,
                      ilp_lp_ws* w,
@@ -1282,7 +575,7 @@ ilp_branch_and_bound(const ilp_graph* g,
  * the heuristic's value of the component (sum of c_e y_e), tol the tolerance
  * of value comparisons. */
 static dacpo_status
-ilp_lp_component(const ilp_graph* g,
+ilp_lp_component(const dacpo_ilp_graph* g,
                  size_t ci,
                  ilp_lp_ws* w,
                  ilp_abort* ab,
@@ -1453,7 +746,7 @@ ilp_ws_free(ilp_lp_ws* w)
 /* Gives every component the heuristic leaves frustrated to lp_solve and keeps
  * the better of the two answers in o. */
 static dacpo_status
-ilp_solve_components(const ilp_graph* g,
+ilp_solve_components(const dacpo_ilp_graph* g,
                      ilp_lp_ws* w,
                      ilp_abort* ab,
                      double tol,
@@ -1467,7 +760,7 @@ ilp_solve_components(const ilp_graph* g,
     size_t mc = g->cedge_start[ci + 1] - g->cedge_start[ci];
     if (mc + 1 <= nc)
       continue; /* single node or tree: the spanning-tree propagation is exact */
-    double h = ilp_comp_value(g, ci, o);
+    double h = dacpo_ilp_comp_value(g, ci, o);
     double ub = 0.0; /* every edge at its preferred value */
     for (size_t q = g->cedge_start[ci]; q < g->cedge_start[ci + 1]; ++q)
       ub += g->c[g->cedges[q]] > 0.0 ? g->c[g->cedges[q]] : 0.0;
@@ -1486,7 +779,7 @@ ilp_solve_components(const ilp_graph* g,
     DACPO_TRY(ilp_lp_component(g, ci, w, ab, h, tol, o_lp, &out, result, err));
     if (out.incumbent_optimal)
       continue;
-    double l = out.have ? ilp_comp_value(g, ci, o_lp) : -INFINITY;
+    double l = out.have ? dacpo_ilp_comp_value(g, ci, o_lp) : -INFINITY;
     if (out.have && l >= h) {
       for (size_t q = g->comp_start[ci]; q < g->comp_start[ci + 1]; ++q)
         o[g->comp_nodes[q]] = o_lp[g->comp_nodes[q]];
@@ -1518,8 +811,8 @@ dacpo_ilp_solve(size_t num_nodes,
     return dacpo_err_set(
         err, DACPO_ERR_CANCELLED, "ilp: cancelled by the progress callback");
 
-  ilp_graph g;
-  DACPO_TRY(ilp_graph_build(num_nodes, num_edges, edges, &g, err));
+  dacpo_ilp_graph g;
+  DACPO_TRY(dacpo_ilp_graph_build(num_nodes, num_edges, edges, &g, err));
   dacpo_status st = DACPO_OK;
   uint8_t* o = dacpo_calloc_array(num_nodes, 1);
   uint8_t* o_lp = dacpo_calloc_array(num_nodes, 1);
@@ -1530,7 +823,7 @@ dacpo_ilp_solve(size_t num_nodes,
   }
 
   /* Restarts of the heuristic may use a quarter of the time limit. */
-  st = ilp_heuristic(&g, t0 + 0.25 * time_limit, o, err);
+  st = dacpo_ilp_heuristic(&g, t0 + 0.25 * time_limit, o, err);
   if (st != DACPO_OK)
     goto done;
 
@@ -1565,6 +858,6 @@ done:
   free(o);
   free(o_lp);
   ilp_ws_free(&w);
-  ilp_graph_free(&g);
+  dacpo_ilp_graph_free(&g);
   return st;
 }

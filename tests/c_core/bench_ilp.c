@@ -13,7 +13,8 @@
  *
  * Build (from the repository root; not part of the test suite):
  *   gcc -std=c11 -O2 -Ic_core/include -Ic_core/src -I/usr/include/lpsolve \
- *       tests/c_core/bench_ilp.c c_core/src/dacpo_ilp.c c_core/src/dacpo_context.c \
+ *       tests/c_core/bench_ilp.c c_core/src/dacpo_ilp.c c_core/src/dacpo_ilp_graph.c \
+ *       c_core/src/dacpo_ilp_heuristic.c c_core/src/dacpo_context.c \
  *       -L/usr/lib/lp_solve -llpsolve55 -Wl,-rpath,/usr/lib/lp_solve -lm -o bench_ilp
  * Usage: bench_ilp [time_limit_seconds] [noise] */
 #include "dacpo_ilp.h"

@@ -35,6 +35,38 @@ namespace {
 
 constexpr std::size_t kGraphK = 10;
 
+/* The command line of the tool. */
+struct EvalOptions {
+  std::vector<std::string> files; /* ground truth, prediction */
+  std::string colored, normals_colored;
+  bool json = false;
+};
+
+/* One command-line option. The help text, the parser and the unknown-option
+ * check all read the table below (kEvalOptions), so an option is named once;
+ * file names are checked in parseEvalOptions(). */
+using EvalOptionSpec = dacpo_tool::OptionSpec<EvalOptions, EvalOptions>;
+
+const EvalOptionSpec kEvalOptions[] = {
+    {"-normals_colored",
+     "F.{pcd,ply}",
+     "the predicted cloud coloured by\n"
+     "normal direction, RGB = (n + 1) / 2",
+     nullptr,
+     dacpo_tool::setText<&EvalOptions::normals_colored>},
+    {"-colored",
+     "out.pcd",
+     "write the points coloured blue (correct)\n"
+     "  or red (wrong) with the predicted normals",
+     nullptr,
+     dacpo_tool::setText<&EvalOptions::colored>},
+    {"-json",
+     nullptr,
+     "print one line of JSON on stdout:",
+     nullptr,
+     dacpo_tool::setFlag<&EvalOptions::json>},
+};
+
 void
 printHelp(int, char** argv)
 {
@@ -49,16 +81,7 @@ printHelp(int, char** argv)
   print_info(
       "  hold the same points in the same order; NaN predicted normals are wrong.\n");
   print_info("  where options are:\n");
-  print_info(
-      "                     -normals_colored F.{pcd,ply} = the predicted cloud "
-      "coloured by\n"
-      "                                      normal direction, RGB = (n + 1) / 2\n");
-  print_info("                     -colored out.pcd = write the points coloured blue "
-             "(correct)\n");
-  print_info("                                        or red (wrong) with the "
-             "predicted normals\n");
-  print_info(
-      "                     -json            = print one line of JSON on stdout:\n");
+  dacpo_tool::printOptionTable(kEvalOptions, EvalOptions(), 16, 38);
   print_info("  {\"file\":..., \"points\":N, \"wrong_pct\":x, "
              "\"largest_component_points\":M,\n");
   print_info("   \"largest_component_wrong_pct\":y, \"components\":C,\n");
@@ -339,12 +362,19 @@ saveColored(const std::string& path,
   return true;
 }
 
-/* The command line of the tool. */
-struct EvalOptions {
-  std::vector<std::string> files; /* ground truth, prediction */
-  std::string colored, normals_colored;
-  bool json = false;
-};
+/* Sets the options of kEvalOptions as PCL's parse_argument and find_switch
+ * read them: the first occurrence counts, a value option at the very end is
+ * left unset (checkArguments has rejected unknown options before). */
+void
+applyEvalOptions(int argc, char** argv, EvalOptions& o)
+{
+  for (const EvalOptionSpec& spec : kEvalOptions) {
+    std::string value, unused;
+    if (spec.arg ? parse_argument(argc, argv, spec.name, value) >= 0
+                 : find_switch(argc, argv, spec.name))
+      spec.apply(o, value, unused);
+  }
+}
 
 /* Reads and checks the command line; false: exit with *exit_code (help, or a
  * message was printed). */
@@ -359,20 +389,19 @@ parseEvalOptions(int argc, char** argv, EvalOptions& o, int& exit_code)
     return false;
   }
   std::string error;
-  if (!dacpo_tool::checkArguments(
-          argc, argv, {"-json"}, {"-colored", "-normals_colored"}, error)) {
+  if (!dacpo_tool::checkOptionTable(kEvalOptions, argc, argv, error)) {
     print_error("Error: %s\n", error.c_str());
     return false;
   }
-  o.files = dacpo_tool::fileArguments(argc, argv, {"-colored", "-normals_colored"});
+  o.files = dacpo_tool::fileArguments(
+      argc, argv, dacpo_tool::optionNames(kEvalOptions, true));
   if (o.files.size() != 2) {
     print_error("Need a ground-truth and a predicted file (.pcd or .ply), got %zu.\n",
                 o.files.size());
     printHelp(argc, argv);
     return false;
   }
-  parse_argument(argc, argv, "-colored", o.colored);
-  parse_argument(argc, argv, "-normals_colored", o.normals_colored);
+  applyEvalOptions(argc, argv, o);
   if (!o.normals_colored.empty() &&
       dacpo_tool::extension(o.normals_colored) != ".pcd" &&
       dacpo_tool::extension(o.normals_colored) != ".ply") {
@@ -385,7 +414,6 @@ parseEvalOptions(int argc, char** argv, EvalOptions& o, int& exit_code)
                 o.colored.c_str());
     return false;
   }
-  o.json = find_switch(argc, argv, "-json");
   return true;
 }
 

@@ -101,16 +101,10 @@ const std::vector<std::string> kLabelFields = {"block", "component", "flip"};
 
 /* One command-line option. The help text, the parser and the unknown-option
  * check all read the table below (kOptions), so an option is named once. */
-struct OptionSpec {
-  const char* name;
-  const char* arg;  /* nullptr: a switch; else the value's placeholder in -h */
-  const char* help; /* '\n' starts a continuation line */
-  /* the default shown in -h; nullptr: none */
-  std::string (*shown)(const dacpo_params&);
-  /* sets the options from the value (a switch gets ""); false + error */
-  bool (*apply)(Options&, const std::string&, std::string&);
-};
+using OptionSpec = dacpo_tool::OptionSpec<Options, dacpo_params>;
 
+using dacpo_tool::setFlag;
+using dacpo_tool::setText;
 using dacpo_tool::toDouble;
 using dacpo_tool::toUnsigned;
 
@@ -149,23 +143,6 @@ showNumber(const dacpo_params& d)
   std::ostringstream out;
   out << d.*Field;
   return out.str();
-}
-
-/* Options whose value is kept as given and checked in finishOptions(). */
-template <std::string Options::*Field>
-bool
-setText(Options& o, const std::string& s, std::string&)
-{
-  o.*Field = s;
-  return true;
-}
-
-template <bool Options::*Field>
-bool
-setFlag(Options& o, const std::string&, std::string&)
-{
-  o.*Field = true;
-  return true;
 }
 
 const OptionSpec kOptions[] = {
@@ -413,24 +390,7 @@ printHelp(int, char** argv)
   print_info("  written (replaced if present). PCD is written binary compressed, PLY "
              "binary.\n");
   print_info("  where options are:\n");
-  for (const OptionSpec& spec : kOptions) {
-    std::string head = spec.name;
-    if (spec.arg)
-      head += std::string(" ") + spec.arg;
-    if (head.size() < 11)
-      head.resize(11, ' ');
-    std::string text = spec.help;
-    for (std::size_t at = text.find('\n'); at != std::string::npos;
-         at = text.find('\n', at + 1))
-      text.insert(at + 1, 35, ' ');
-    print_info("                     %s = %s", head.c_str(), text.c_str());
-    if (spec.shown) {
-      print_info(" (default: ");
-      print_value("%s", spec.shown(d).c_str());
-      print_info(")");
-    }
-    print_info("\n");
-  }
+  dacpo_tool::printOptionTable(kOptions, d, 11, 35);
   print_info("  After a successful run the last line on stderr is always\n");
   print_info("  \"stats: points=... blocks=... edges=... ... seconds=... "
              "peak_rss_mb=...\".\n");
@@ -924,56 +884,6 @@ saveMesh(const std::string& filename, const Result& r)
   return true;
 }
 
-const OptionSpec*
-findOption(const char* name)
-{
-  for (const OptionSpec& spec : kOptions)
-    if (std::strcmp(spec.name, name) == 0)
-      return &spec;
-  return nullptr;
-}
-
-/* The switches and the options that take a value, for dacpo_tool::checkArguments
- * and dacpo_tool::fileArguments. */
-std::vector<const char*>
-optionNames(bool with_value)
-{
-  std::vector<const char*> names;
-  for (const OptionSpec& spec : kOptions)
-    if ((spec.arg != nullptr) == with_value)
-      names.push_back(spec.name);
-  return names;
-}
-
-/* Applies the options in command-line order: a repeated option keeps its last
- * value. */
-bool
-applyOptions(int argc, char** argv, Options& o)
-{
-  for (int i = 1; i < argc; ++i) {
-    const OptionSpec* spec = findOption(argv[i]);
-    if (spec == nullptr)
-      continue; /* a file (unknown options were rejected before) */
-    std::string value, error;
-    if (spec->arg != nullptr) {
-      if (i + 1 >= argc || argv[i + 1][0] == '\0') {
-        const bool file = std::strncmp(spec->arg, "F.", 2) == 0;
-        print_error("Error: %s needs a %s (%s)\n",
-                    spec->name,
-                    file ? "file name" : "value",
-                    spec->arg);
-        return false;
-      }
-      value = argv[++i];
-    }
-    if (!spec->apply(o, value, error)) {
-      print_error("Error: %s %s\n", spec->name, error.c_str());
-      return false;
-    }
-  }
-  return true;
-}
-
 /* -sign and -vp into the sign policy (and the viewpoint). */
 bool
 resolveSignPolicy(Options& o)
@@ -1055,7 +965,7 @@ bool
 parseOptions(int argc, char** argv, Options& o)
 {
   dacpo_params_init(&o.params);
-  if (!applyOptions(argc, argv, o) || !resolveSignPolicy(o))
+  if (!dacpo_tool::applyOptions(kOptions, argc, argv, o) || !resolveSignPolicy(o))
     return false;
   if (o.separate)
     o.params.disconnected = DACPO_DISCONNECTED_SEPARATE;
@@ -1206,8 +1116,7 @@ main(int argc, char** argv)
   }
   {
     std::string error;
-    if (!dacpo_tool::checkArguments(
-            argc, argv, optionNames(false), optionNames(true), error)) {
+    if (!dacpo_tool::checkOptionTable(kOptions, argc, argv, error)) {
       print_error("Error: %s\n", error.c_str());
       return 1;
     }
@@ -1216,7 +1125,7 @@ main(int argc, char** argv)
   if (!parseOptions(argc, argv, options))
     return 1;
   const std::vector<std::string> files =
-      dacpo_tool::fileArguments(argc, argv, optionNames(true));
+      dacpo_tool::fileArguments(argc, argv, dacpo_tool::optionNames(kOptions, true));
   if (options.input_dir.empty() ? files.size() != 2 : !files.empty()) {
     print_error(options.input_dir.empty()
                     ? "Need one input and one output file (.pcd or .ply), got %zu.\n"
