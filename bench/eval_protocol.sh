@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The paper's evaluation protocol (§6) on this project's data: every real scan in
-# ../shared/data (when present) and generated rooms in the paper's variants
+# $DACPO_REAL_DATA (a folder of PLYs with ground-truth normals, when set) and
+# generated rooms in the paper's variants
 # (clean, noise sigma 0.004 / 0.008, random downsampling to 100K / 10K).
 # For each input: orient from PCA normals (signs unknown), then score with
 # pcl_dacpo_eval. Prints one JSON line per run (eval result + wall seconds +
@@ -24,13 +25,13 @@ done
 extra=("$@")
 tools="$build/wrappers"
 mkdir -p "$out/in" "$out/res"
-data="$root/../shared/data"
+data="${DACPO_REAL_DATA:-}"
 
 inputs=()
-if [ -d "$data" ]; then
+if [ -n "$data" ] && [ -d "$data" ]; then
   for f in "$data"/*.ply; do inputs+=("real:$f"); done
 else
-  echo "# $data not found: real scans skipped" >&2
+  echo "# DACPO_REAL_DATA not set or not a folder: real scans skipped" >&2
 fi
 gen() { # name args...
   local name="$1"; shift

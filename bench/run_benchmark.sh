@@ -8,12 +8,13 @@
 #   bench/run_benchmark.sh --full --all    # 500K rooms, 3 seeds, scaling up to 4M (hours)
 #   bench/run_benchmark.sh --robustness [robustness.py options] [DIR ...]
 #                                          # every ground-truth PLY of DIR (default:
-#                                          # ../shared/data and ../shared/rooms) x seeds
-#                                          # 1-5: median, worst, spread, error split
+#                                          # $DACPO_REAL_DATA and $DACPO_ROOMS_DATA) x
+#                                          # seeds 1-5: median, worst, spread, error split
 #
 # Accuracy suite: generated rooms in the paper's variants (clean, Gaussian noise
 # sigma 0.004 / 0.008, random downsampling to 100K / 10K) and every PLY in
-# ../shared/data when present (real scans; skipped with a note otherwise),
+# --data DIR or $DACPO_REAL_DATA when given (real scans with ground-truth
+# normals; skipped with a note otherwise),
 # oriented by pcl_dacpo (default), its ablations (-no_ipsr, -weights dipole,
 # -blocks 1) and the peers that are installed (Open3D, CGAL, PCL viewpoint;
 # scripts/install_bench_deps.sh), every method starting from unsigned PCA
@@ -35,7 +36,9 @@ if [ "${1:-}" = "--robustness" ]; then
   has_input=0
   for a in "$@"; do case "$a" in -*) ;; *) [ -e "$a" ] && has_input=1 ;; esac; done
   if [ "$has_input" = 0 ]; then
-    set -- "$@" "$root/../shared/data" "$root/../shared/rooms"
+    for d in "${DACPO_REAL_DATA:-}" "${DACPO_ROOMS_DATA:-}"; do
+      [ -n "$d" ] && set -- "$@" "$d"
+    done
   fi
   exec python3 "$root/bench/robustness.py" "$@"
 fi
@@ -58,7 +61,7 @@ USAGE = """usage: bench/run_benchmark.sh [options]
                      are missing)
   -w DIR             work directory for generated inputs and predictions (default: <build>/bench)
   -o DIR             results directory (default: <repo>/bench/results)
-  --data DIR         real scans, every *.ply (default: <repo>/../shared/data)
+  --data DIR         real scans, every *.ply (default: $DACPO_REAL_DATA, unset = none)
   --no-real          skip the real scans
   --room-n N         points of the generated rooms before downsampling
   --seeds N          generated rooms per variant (seeds 1..N)
@@ -75,7 +78,7 @@ USAGE = """usage: bench/run_benchmark.sh [options]
 
 opt = dict(mode="quick", what=None, build=os.path.join(ROOT, "build"), work=None,
            results=os.path.join(ROOT, "bench", "results"),
-           data=os.path.normpath(os.path.join(ROOT, "..", "shared", "data")), real=True,
+           data=os.environ.get("DACPO_REAL_DATA", ""), real=True,
            room_n=None, seeds=None, sizes=None, methods=None, extra=[], threads=0,
            timeout=None, o3d_timeout=None)
 i = 0
@@ -395,7 +398,7 @@ def accuracy_inputs():
             if not plys:
                 notes.append(f"no *.ply in {opt['data']}: real-scan column empty")
         else:
-            notes.append(f"{opt['data']} not found: real scans skipped")
+            notes.append(f"{opt['data'] or 'no --data DIR / DACPO_REAL_DATA'}: real scans skipped")
     else:
         notes.append("real scans skipped (--no-real)")
     return items

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Benchmark of stage 3 (dacpo_ipsr_block) on ~2,500-point blocks: generated
- * open and thin surfaces, and (given PLY files with ground-truth normals, like
- * ../shared/data/ *.ply) blocks cut from real scans as the k nearest points of a
+ * open and thin surfaces, and (given PLY files with ground-truth normals: float
+ * x y z nx ny nz) blocks cut from real scans as the k nearest points of a
  * random seed. Every block starts from its true normals with a share flipped at
  * random. One line per block: grid, Poisson domain cells, iterations ('*' =
  * stopped at max_iterations), CPU time of the block (this thread's clock, so
@@ -22,7 +22,7 @@
  *              [-maxres cells_per_axis] [-maxcells cells] [-band cells]
  *              [-trim spacings] [-iters max] [-noise sigma_in_spacings]
  *              [-gen kinds(0-5)] [-dump path_prefix] [file.ply ...]
- * e.g. bench_ipsr -blocks 4 ../shared/data/ *.ply (without the space). */
+ * e.g. bench_ipsr -blocks 4 scans/ *.ply (without the space). */
 #define _POSIX_C_SOURCE 200809L
 #include "dacpo_ipsr.h"
 #include "dacpo_kdtree.h"
