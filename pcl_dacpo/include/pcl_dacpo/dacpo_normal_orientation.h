@@ -763,6 +763,9 @@ private:
   /** \brief Forgets the status, stats and results of the previous run. */
   void
   clearResults();
+  /** \brief Empties the per-point labels, edges and mesh of the previous run. */
+  void
+  clearLabels();
   /** \brief Rejects the set-ups DACPO does not support (false: output failed). */
   bool
   checkSetup(PointCloudOut& output);

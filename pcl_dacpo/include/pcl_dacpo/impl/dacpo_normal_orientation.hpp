@@ -205,13 +205,7 @@ DACPONormalOrientation<PointInT, PointOutT>::fail(PointCloudOut& output,
             message.c_str());
   output.width = output.height = 0;
   output.clear();
-  component_labels_.clear();
-  point_confidence_.clear();
-  block_labels_.clear();
-  block_flips_.clear();
-  edges_.clear();
-  mesh_vertices_.clear();
-  mesh_triangles_.clear();
+  clearLabels();
 }
 
 template <typename PointInT, typename PointOutT>
@@ -416,6 +410,13 @@ DACPONormalOrientation<PointInT, PointOutT>::clearResults()
   last_status_ = DACPO_OK;
   last_error_.clear();
   std::memset(&stats_, 0, sizeof(stats_));
+  clearLabels();
+}
+
+template <typename PointInT, typename PointOutT>
+void
+DACPONormalOrientation<PointInT, PointOutT>::clearLabels()
+{
   component_labels_.clear();
   point_confidence_.clear();
   block_labels_.clear();
