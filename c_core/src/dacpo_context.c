@@ -95,7 +95,7 @@ dacpo_params_init(dacpo_params* p)
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
-  p->dipole_layers = 0.0;
+  p->dipole_layers = 2.0;
 }
 
 static dacpo_status

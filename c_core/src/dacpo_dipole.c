@@ -174,7 +174,8 @@ typedef struct two_sheet_scale {
  * second sheet beneath it. Measured per block (~2,500 points): single depth
  * frames 0-2.6 %, room blocks holding thin furniture mostly 3-53 %; blocks of
  * sparse rooms (10K points), whose thin parts lie closer than the two-sheet
- * test resolves, also stay below, which is why the layer rule is opt-in. */
+ * test resolves, also stay below: there the rule keeps to offsets beyond the
+ * two-sheet window (dacpo_params.dipole_layers = 2 by default). */
 #define DACPO_ONE_SIDED_MAX_SHEET 0.03
 
 static dacpo_status
@@ -304,8 +305,9 @@ two_sheet_pair(const two_sheet_scale* ts,
  * offset by 0.5-2 spacings (two-sheet pairs aside) face the same way in
  * 98-99.8 % of cases on single depth frames, and the opposite way in 72-97 % on
  * dense rooms with thin parts (26-58 % on 10K-point rooms), so the rule is
- * applied only in blocks where the two-sheet test finds (almost) no thin part,
- * and only when asked for (params->layers > 0): sparse rooms pass that test too.
+ * applied only in blocks where the two-sheet test finds (almost) no thin part;
+ * sparse rooms pass that test too, so by default only offsets beyond the
+ * two-sheet window (2 spacings) count as layers.
  * For a layer pair c = 1: e becomes n.(I - r^r^T).m / |r|^3, the stacked
  * direction carries no vote. */
 static int

@@ -205,10 +205,10 @@ typedef struct dacpo_params {
                                       (dipole_two_sheet). Measured (0.5-2 spacings):
                                       such pairs face the same way in 98-99.8 % of
                                       cases on single depth frames, the opposite way in
-                                      72-97 % on rooms with thin parts; 15 depth frames
-                                      4.80 -> 2.72 % wrong, 18 rooms 7.95 -> 8.30 %.
-                                      0 = off (default); 0.5 for single-view depth
-                                      data */
+                                      72-97 % on rooms with thin parts. Seeds 1-5: 2
+                                      (default): 15 depth frames 4.80 -> 3.66 % wrong,
+                                      18 rooms 7.95 -> 8.01 %; 0.5 (single-view depth
+                                      data): frames 2.72 %, rooms 8.30 %. 0 = off */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
