@@ -96,6 +96,7 @@ dacpo_params_init(dacpo_params* p)
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
   p->dipole_layers = 2.0;
+  p->dipole_sides = 0.0;
 }
 
 static dacpo_status
@@ -225,6 +226,11 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_layers must be finite and >= 0 (got %g)",
                      p->dipole_layers);
+  if (!(p->dipole_sides >= 0.0) || !isfinite(p->dipole_sides))
+    return bad_field(message,
+                     size,
+                     "dipole_sides must be finite and >= 0 (got %g)",
+                     p->dipole_sides);
   return DACPO_OK;
 }
 

@@ -13,7 +13,10 @@
  * pairs recognised as the two faces of one thin part get an "opposite" energy
  * instead (two_sheet_pair below; params->two_sheet = 0 keeps Eq. 2), and in a
  * block seen from one side, stacked layers of one surface get c = 1 (layer_pair;
- * params->layers = 0 keeps Eq. 2).
+ * params->layers = 0 keeps Eq. 2). In blocks with parts thinner than the
+ * spacing, the side cue (dacpo_sheet_side.c; params->sides > 0) makes pairs
+ * on the two faces "opposite" and adds a field that turns each face away from
+ * the other (side_field).
  * Since e((p,s n),(q,t m)) = s t e((p,n),(q,m)), every later decision is a signed
  * sum of these cached numbers. M randomized BFS orders over the (symmetrized)
  * graph_k-NN graph each give a greedy sign vector (Eq. 4); the M vectors are
@@ -38,6 +41,7 @@
 #include "dacpo_dipole.h"
 
 #include "dacpo_kdtree.h"
+#include "dacpo_sheet_side.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -73,6 +77,7 @@ dacpo_dipole_energy(const double p[3],
 typedef struct dipole_work {
   int32_t* nb;      /* n*K nearest neighbours, padded with the point itself */
   double* w;        /* n*K e(p_j -> p_i) of the unflipped axes */
+  double* unary;    /* n field of the thin-part side cue on i, or NULL */
   size_t* gstart;   /* n+1 CSR of the symmetrized graph_k-NN graph */
   int32_t* gnbr;    /* gstart[n] */
   int8_t* sign;     /* M*n sign vectors, 0 = not yet placed */
@@ -92,6 +97,7 @@ dipole_work_free(dipole_work* wk)
 {
   free(wk->nb);
   free(wk->w);
+  free(wk->unary);
   free(wk->gstart);
   free(wk->gnbr);
   free(wk->sign);
@@ -396,6 +402,92 @@ thin_part_setup(const double* xyz,
   return DACPO_OK;
 }
 
+/* The side cue's first test fires on 0.1-3.5 % of the points of a single depth
+ * frame's blocks (noise, no preference) and on 7-78 % of the points of room
+ * blocks that hold thin parts; below this share a block gets no cue. */
+#define DACPO_SIDE_MIN_SHARE 0.05
+
+/* A pair that a sure side fit puts on two faces gets the two-sheet energy
+ * (pair_energy), blended by the fit's confidence, in both rows that hold it. */
+static void
+side_pairs(const double* xyz,
+           const double* nrm,
+           size_t n,
+           size_t K,
+           dipole_work* wk,
+           const int8_t* face)
+{
+  for (size_t i = 0; i < n; ++i) {
+    const double conf = fabs(wk->unary[i]);
+    for (size_t t = 0; conf > 0.0 && t < K; ++t) {
+      if (face[i * K + t] >= 0)
+        continue;
+      const size_t j = (size_t)wk->nb[i * K + t];
+      const double* p = xyz + 3 * i;
+      const double* q = xyz + 3 * j;
+      const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+      const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+      const double nm = nrm[3 * i] * nrm[3 * j] + nrm[3 * i + 1] * nrm[3 * j + 1] +
+                        nrm[3 * i + 2] * nrm[3 * j + 2];
+      const double opp = -DACPO_TWO_SHEET_WEIGHT * nm / (rr * sqrt(rr));
+      double* w = &wk->w[i * K + t];
+      *w += conf * (opp - *w);
+      for (size_t s = 0; s < K; ++s)
+        if ((size_t)wk->nb[j * K + s] == i) {
+          w = &wk->w[j * K + s];
+          *w += conf * (opp - *w);
+          break;
+        }
+    }
+  }
+}
+
+/* The thin-part side cue as a field on every point (dacpo_sheet_side.c):
+ * weight x side_i x sum_t |e_ti|, so a sure cue (|side| = 1) with weight >= 1
+ * outweighs all of the point's pair energies. spacing 0 = not yet measured. */
+static dacpo_status
+side_field(const double* xyz,
+           const double* nrm,
+           size_t n,
+           size_t K,
+           double weight,
+           double spacing,
+           dipole_work* wk,
+           dacpo_err* err)
+{
+  wk->unary = dacpo_malloc_array(n, sizeof(double));
+  if (!wk->unary)
+    return DACPO_OOM(err);
+  if (!(spacing > 0.0)) {
+    for (size_t i = 0; i < n; ++i) {
+      const double* p = xyz + 3 * i;
+      const double* q = xyz + 3 * (size_t)wk->nb[i * K];
+      wk->unary[i] =
+          sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+               (q[2] - p[2]) * (q[2] - p[2]));
+    }
+    spacing = dacpo_select_kth(wk->unary, n, n / 2);
+  }
+  int8_t* face = dacpo_malloc_array(n * K, sizeof(int8_t));
+  if (!face)
+    return DACPO_OOM(err);
+  size_t fired = 0;
+  dacpo_status st =
+      dacpo_sheet_side(xyz, nrm, n, wk->nb, K, spacing, wk->unary, face, &fired, err);
+  if ((double)fired < DACPO_SIDE_MIN_SHARE * (double)n)
+    memset(wk->unary, 0, n * sizeof(double)); /* one-sided block: no cue */
+  else if (st == DACPO_OK)
+    side_pairs(xyz, nrm, n, K, wk, face);
+  free(face);
+  for (size_t i = 0; st == DACPO_OK && i < n; ++i) {
+    double mag = 0.0;
+    for (size_t t = 0; t < K; ++t)
+      mag += fabs(wk->w[i * K + t]);
+    wk->unary[i] *= weight * mag;
+  }
+  return st;
+}
+
 /* K nearest of every point (self dropped) and the cached pair energies. */
 static dacpo_status
 dipole_neighbors(const double* xyz,
@@ -448,6 +540,8 @@ dipole_neighbors(const double* xyz,
       wrow[t] = j == i ? 0.0 : pair_energy(&ts, xyz, nrm, i, j, c, band);
     }
   }
+  if (st == DACPO_OK && prm->sides > 0.0)
+    st = side_field(xyz, nrm, n, K, prm->sides, ts.spacing, wk, err);
   free(ts.noise);
   free(ts.local);
   free(ts.sheet);
@@ -523,7 +617,8 @@ dipole_decide(const dipole_work* wk, size_t K, size_t i, const int8_t* s)
   /* Unplaced points have s == 0 and drop out without a branch: whether a
    * neighbour is placed is random, a branch on it would mispredict half the
    * time and cost more than the sum itself. */
-  return dipole_field_sum(row, wrow, K, s) >= 0.0 ? 1 : -1;
+  const double u = wk->unary ? wk->unary[i] : 0.0;
+  return dipole_field_sum(row, wrow, K, s) + u >= 0.0 ? 1 : -1;
 }
 
 /* One randomized BFS order; signs placed in s (length n, zeroed here). */
@@ -641,7 +736,8 @@ dipole_confidence(
   for (size_t i = 0; i < n; ++i) {
     const int32_t* row = wk->nb + i * K;
     const double* w = wk->w + i * K;
-    double sum = 0.0, mag = 0.0;
+    double sum = wk->unary ? wk->unary[i] : 0.0;
+    double mag = fabs(sum);
     for (size_t t = 0; t < K; ++t) {
       sum += (double)s[row[t]] * w[t];
       mag += fabs(w[t]);
@@ -661,7 +757,8 @@ dipole_sweeps(dipole_work* wk, size_t n, size_t K, int sweeps, int8_t* cand)
     size_t changed = 0;
     for (size_t o = 0; o < n; ++o) {
       const size_t i = (size_t)wk->order0[o];
-      const double sum = dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand);
+      const double sum = dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand) +
+                         (wk->unary ? wk->unary[i] : 0.0);
       const int8_t v = sum > 0.0 ? 1 : sum < 0.0 ? -1 : cand[i];
       changed += v != cand[i];
       cand[i] = v;
@@ -702,9 +799,12 @@ dipole_restart(dipole_work* wk,
   if (!score)
     return 0.0;
   double energy = 0.0;
-  for (size_t i = 0; i < n; ++i)
-    energy +=
-        (double)cand[i] * dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand);
+  for (size_t i = 0; i < n; ++i) {
+    /* pairs are counted from both ends, the cue once: 2 x unary */
+    const double u = wk->unary ? 2.0 * wk->unary[i] : 0.0;
+    energy += (double)cand[i] *
+              (dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand) + u);
+  }
   return energy;
 }
 
@@ -804,6 +904,9 @@ dacpo_dipole_orient_confidence(const double* xyz,
     }
   }
   memcpy(sign_out, wk.cand + best * n, n);
+  if (params->thin_out)
+    for (size_t i = 0; i < n; ++i)
+      params->thin_out[i] = wk.unary && wk.unary[i] != 0.0;
   if (confidence)
     dipole_confidence(&wk, n, K, R, best, confidence);
   dipole_work_free(&wk);

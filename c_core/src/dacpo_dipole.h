@@ -27,6 +27,12 @@ typedef struct dacpo_dipole_params {
   double layers;     /* 0 = off; else, in a block seen from one side, parallel
                         pairs offset by more than layers x local spacing get
                         c = 1 (dacpo_params.dipole_layers) */
+  double sides;      /* 0 = off; else weight of the thin-part side cue
+                        (dacpo_sheet_side.h; dacpo_params.dipole_sides) */
+  uint8_t* thin_out; /* optional output (n entries, may be NULL): 1 where the
+                        side cue fired, i.e. the point lies on a part thinner
+                        than the block's Poisson grid resolves (stage 3 keeps
+                        its stage-2 normal) */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for

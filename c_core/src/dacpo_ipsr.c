@@ -79,6 +79,7 @@ dacpo_ipsr_params_default(dacpo_ipsr_params* p)
   p->max_cg_iterations = 30;
   p->trim_interior = 0;
   p->band = 2;
+  p->fixed = NULL;
 }
 
 /* Scratch of one block run; every array is freed by ipsr_clear. */
@@ -523,11 +524,16 @@ ipsr_setup(ipsr_work* w,
 }
 
 /* Every kept face sends its area-weighted normal to its k nearest samples;
- * each sample's new normal is the normalized sum (one that received nothing
- * keeps its normal). change[s] = |n_new - n_old|. */
+ * each sample's new normal is the normalized sum (one that received nothing,
+ * or is fixed, keeps its normal). change[s] = |n_new - n_old|. */
 static void
-ipsr_vote(
-    ipsr_work* w, const dacpo_mesh* mesh, size_t k, double* nrm, double* old, size_t n)
+ipsr_vote(ipsr_work* w,
+          const dacpo_mesh* mesh,
+          size_t k,
+          const uint8_t* fixed,
+          double* nrm,
+          double* old,
+          size_t n)
 {
   memset(w->acc, 0, 3 * n * sizeof(double));
   for (size_t f = 0; f < mesh->num_triangles; ++f) {
@@ -548,7 +554,7 @@ ipsr_vote(
   for (size_t s = 0; s < n; ++s) {
     double* a = w->acc + 3 * s;
     double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    if (len > 0.0 && isfinite(len)) {
+    if (len > 0.0 && isfinite(len) && !(fixed && fixed[s])) {
       nrm[3 * s] = a[0] / len;
       nrm[3 * s + 1] = a[1] / len;
       nrm[3 * s + 2] = a[2] / len;
@@ -653,7 +659,7 @@ ipsr_iterate(ipsr_work* w,
     run->mesh_trimmed = trimming;
     if (iters == 0)
       break;
-    ipsr_vote(w, run->mesh, k, nrm, old, n);
+    ipsr_vote(w, run->mesh, k, params->fixed, nrm, old, n);
     t[3] = dacpo_now();
     ipsr_iteration_stats(w, run->mesh, k, it, t, st);
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);

@@ -26,6 +26,9 @@ typedef struct dacpo_ipsr_params {
   int trim_interior;        /* 1: trim every far face, also inside the data (0) */
   size_t band;              /* Poisson domain: cells within this many cells of the
                                samples (>= 2); 0 = the whole padded box (2) */
+  const uint8_t* fixed;     /* NULL, or n flags: samples whose normals the
+                               iterations leave as given (parts thinner than
+                               the grid, see dacpo_pipeline.c) (NULL) */
 } dacpo_ipsr_params;
 
 void

@@ -195,30 +195,11 @@ estimate_normals(run_state* s, dacpo_err* err)
 
 /* ---- stages 2-3: one block at a time ----------------------------------- */
 
-static dacpo_status
-orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
+/* Stage 2's parameters for block b (its own random stream); thin: the block's
+ * thin-part flags (output). */
+static dacpo_dipole_params
+block_dipole_params(const run_state* s, size_t b, uint8_t* thin)
 {
-  run_state* s = user;
-  const dacpo_blocks* bl = &s->blocks;
-  const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
-  const size_t ring0 = bl->ring_start[b], nr = bl->ring_start[b + 1] - ring0;
-  const size_t n = no + nr;
-  double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
-  double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
-  int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
-  float* conf = dacpo_malloc_array(n, sizeof(float));
-  dacpo_status st = DACPO_OK;
-  if (!xyz || !nrm || !sign || !conf) {
-    st = DACPO_OOM(err);
-    goto done;
-  }
-  /* own points first, then the ring (the ring gives
-   * continuity to propagation and Poisson but is not part of the output) */
-  for (size_t i = 0; i < n; ++i) {
-    int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
-    memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
-    memcpy(nrm + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
-  }
   dacpo_dipole_params dp;
   dp.c = s->p.dipole_c;
   dp.orders = s->p.dipole_orders;
@@ -231,6 +212,37 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   dp.two_sheet = s->p.dipole_two_sheet;
   dp.layers = s->p.dipole_layers;
   dp.restarts = s->p.dipole_restarts;
+  dp.sides = s->p.dipole_sides;
+  dp.thin_out = thin;
+  return dp;
+}
+
+static dacpo_status
+orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
+{
+  run_state* s = user;
+  const dacpo_blocks* bl = &s->blocks;
+  const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
+  const size_t ring0 = bl->ring_start[b], nr = bl->ring_start[b + 1] - ring0;
+  const size_t n = no + nr;
+  double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
+  double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
+  int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
+  float* conf = dacpo_malloc_array(n, sizeof(float));
+  uint8_t* thin = dacpo_malloc_array(n, sizeof(uint8_t));
+  dacpo_status st = DACPO_OK;
+  if (!xyz || !nrm || !sign || !conf || !thin) {
+    st = DACPO_OOM(err);
+    goto done;
+  }
+  /* own points first, then the ring (the ring gives
+   * continuity to propagation and Poisson but is not part of the output) */
+  for (size_t i = 0; i < n; ++i) {
+    int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
+    memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
+    memcpy(nrm + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
+  }
+  const dacpo_dipole_params dp = block_dipole_params(s, b, thin);
   double t0 = dacpo_now();
   st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);
   double t1 = dacpo_now();
@@ -247,6 +259,12 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     dacpo_ipsr_params ip;
     dacpo_ipsr_params_default(&ip);
     ip.max_iterations = s->p.ipsr_enabled ? s->p.ipsr_max_iterations : 0;
+    /* Stage 3 cannot see parts thinner than its grid: on a board 0.3-1
+     * spacing thick its indicator function merges the two faces and turns one
+     * over (two clean sheets half a spacing apart: 0 % wrong after stage 2,
+     * 50 % after stage 3). Points where the stage-2 side cue fired keep their
+     * stage-2 normal through the iterations. */
+    ip.fixed = thin;
     st = dacpo_ipsr_block(
         xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b], err);
     s->block_seconds[2 * b + 1] = dacpo_now() - t1;
@@ -271,6 +289,7 @@ done:
   free(nrm);
   free(sign);
   free(conf);
+  free(thin);
   return st;
 }
 

@@ -147,19 +147,26 @@ sphere(size_t n, uint64_t seed)
 // Two parallel side x side sheets, spacing h, thickness h (the sheets are as
 // close as neighbours within a sheet): the outward normals of the two sides
 // are opposite.
+// Two side x side sheets at spacing h facing away from each other: h apart
+// with their grids over each other, or (gap > 0) gap apart with the lower grid
+// shifted by half a spacing, so no point has a partner straight beneath it.
 Shape
-thin_board(size_t side, double h, uint64_t seed)
+thin_board(size_t side, double h, uint64_t seed, double gap = 0.0)
 {
   Shape s;
   dacpo_rng rng;
   dacpo_rng_seed(&rng, seed, 3);
+  const double shift = gap > 0.0 ? 0.5 * h : 0.0;
+  if (gap <= 0.0)
+    gap = h;
   for (int sheet = 0; sheet < 2; ++sheet) {
     const double nz = sheet == 0 ? 1.0 : -1.0;
+    const double off = sheet == 0 ? 0.0 : shift;
     for (size_t i = 0; i < side; ++i)
       for (size_t j = 0; j < side; ++j)
-        s.add(i * h + jitter(&rng, 0.1 * h),
-              j * h + jitter(&rng, 0.1 * h),
-              nz * 0.5 * h + jitter(&rng, 0.02 * h),
+        s.add(i * h + off + jitter(&rng, 0.1 * h),
+              j * h + off + jitter(&rng, 0.1 * h),
+              nz * 0.5 * gap + jitter(&rng, 0.02 * h),
               0.0,
               0.0,
               nz);
@@ -362,6 +369,38 @@ TEST(DacpoDipole, LayerRuleLeavesThinPartsOpposite)
   dacpo_dipole_params p = pipeline_params();
   p.layers = 0.5;
   EXPECT_GE(orient_score(thin_board(30, 0.01, 13), p), 0.98);
+}
+
+TEST(DacpoDipole, SideCueSeparatesFacesUnderOneSpacing)
+{
+  // Faces 0.4 spacing apart, grids shifted by half a spacing: without the cue
+  // the pair rules leave the rims and patches inside wrong (measured 0.948-0.949
+  // right, seeds 1-3); the side cue turns the faces apart and marks the points
+  // as thin (thin_out), so that stage 3 keeps them.
+  dacpo_dipole_params p = pipeline_params();
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    const Shape s = thin_board(40, 0.01, seed, 0.004);
+    p.seed = seed;
+    p.sides = 0.0;
+    EXPECT_LE(orient_score(s, p), 0.96) << seed;
+    p.sides = 0.5;
+    std::vector<uint8_t> thin(s.size(), 0);
+    p.thin_out = thin.data();
+    EXPECT_GE(orient_score(s, p), 0.99) << seed;
+    size_t marked = 0;
+    for (uint8_t t : thin)
+      marked += t;
+    EXPECT_GE(marked, s.size() * 9 / 10) << seed;
+    p.thin_out = nullptr;
+  }
+  // a single plane: the cue stays silent, nothing is marked
+  const Shape plane = plane_patch(50, 0.01, 4);
+  p.sides = 0.5;
+  std::vector<uint8_t> thin(plane.size(), 1);
+  p.thin_out = thin.data();
+  EXPECT_GE(orient_score(plane, p), 0.999);
+  for (uint8_t t : thin)
+    EXPECT_EQ(t, 0);
 }
 
 TEST(DacpoDipole, VotingOverOrdersBeatsOneOrder)

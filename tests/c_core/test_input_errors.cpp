@@ -581,6 +581,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = std::nan(""); }},
       {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = -0.5; }},
       {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = HUGE_VAL; }},
+      {"dipole_sides", [](dacpo_params* p) { p->dipole_sides = -1.0; }},
+      {"dipole_sides", [](dacpo_params* p) { p->dipole_sides = NAN; }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},
   };
   auto ctx = makeCtx();

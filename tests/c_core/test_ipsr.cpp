@@ -248,6 +248,42 @@ count_hole_faces(const IpsrRun& r, double far, double hole, double gap)
 // trimming removes what runs on past the patch's rim, a hole wider than the
 // band stays open, and a gap narrower than the trimming distance stays
 // covered (interior gaps are not punched).
+TEST(DacpoIpsr, FixedSamplesKeepTheirNormals)
+{
+  // 30 % of the wavy sheet's normals flipped; half of those flipped points are
+  // fixed: they must come out exactly as given, the free ones repaired.
+  Cloud c = wavy_sheet(2500, 13);
+  c.flip(0.3, 14);
+  const std::vector<double> given = c.n;
+  std::vector<uint8_t> fixed(c.size(), 0);
+  size_t fixed_wrong = 0;
+  for (size_t i = 0; i < c.size(); i += 2)
+    if (c.n[3 * i] * c.gt[3 * i] + c.n[3 * i + 1] * c.gt[3 * i + 1] +
+            c.n[3 * i + 2] * c.gt[3 * i + 2] <
+        0.0) {
+      fixed[i] = 1;
+      ++fixed_wrong;
+    }
+  ASSERT_GT(fixed_wrong, 100u);
+  dacpo_ipsr_params prm;
+  dacpo_ipsr_params_default(&prm);
+  prm.fixed = fixed.data();
+  IpsrRun r;
+  run(&c, prm, &r);
+  size_t free_wrong = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (fixed[i]) {
+      for (int d = 0; d < 3; ++d)
+        EXPECT_EQ(c.n[3 * i + d], given[3 * i + d]) << "fixed sample " << i;
+      continue;
+    }
+    free_wrong += c.n[3 * i] * c.gt[3 * i] + c.n[3 * i + 1] * c.gt[3 * i + 1] +
+                      c.n[3 * i + 2] * c.gt[3 * i + 2] <
+                  0.0;
+  }
+  EXPECT_LT(100.0 * free_wrong / (c.size() - fixed_wrong), 1.0);
+}
+
 TEST(DacpoIpsr, TrimmingRemovesWingsKeepsHolesAndCoversGaps)
 {
   const double step = 0.04, hole = 0.35, gap = 2 * step;

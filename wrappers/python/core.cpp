@@ -50,6 +50,7 @@ defaultParams()
   d["dipole_noise_band"] = p.dipole_noise_band;
   d["dipole_two_sheet"] = p.dipole_two_sheet;
   d["dipole_layers"] = p.dipole_layers;
+  d["dipole_sides"] = p.dipole_sides;
   d["vcr_image_size"] = p.vcr_image_size;
   d["vcr_views"] = p.vcr_views;
   d["vcr_perspective"] = p.vcr_perspective != 0;
@@ -93,6 +94,7 @@ toParams(const py::dict& d)
   p.dipole_noise_band = get<double>(d, "dipole_noise_band", p.dipole_noise_band);
   p.dipole_two_sheet = get<double>(d, "dipole_two_sheet", p.dipole_two_sheet);
   p.dipole_layers = get<double>(d, "dipole_layers", p.dipole_layers);
+  p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
   p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
   p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
   p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;

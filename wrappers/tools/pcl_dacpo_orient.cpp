@@ -262,6 +262,13 @@ const OptionSpec kOptions[] = {
      "layers of one surface (no \"opposite\" vote), 0 = off",
      showNumber<double, &dacpo_params::dipole_layers>,
      setDouble<&dacpo_params::dipole_layers>},
+    {"-sides",
+     "X",
+     "thin parts under one spacing: weight of the side cue (the\n"
+     "point's face, from two clusters of offsets off one fitted\n"
+     "quadric) against its pair energies, 0 = off",
+     showNumber<double, &dacpo_params::dipole_sides>,
+     setDouble<&dacpo_params::dipole_sides>},
     {"-orders",
      "X",
      "randomized dipole propagation orders",

@@ -209,6 +209,20 @@ typedef struct dacpo_params {
                                       (default): 15 depth frames 4.80 -> 3.66 % wrong,
                                       18 rooms 7.95 -> 8.01 %; 0.5 (single-view depth
                                       data): frames 2.72 %, rooms 8.30 %. 0 = off */
+  double dipole_sides;           /**< stage 2, parts thinner than the spacing (a
+                                      board 0.3-1 spacing thick): where a point's
+                                      parallel neighbours lie on two copies of one
+                                      smooth surface, one over the other, the pairs
+                                      across them face opposite ways, the point's
+                                      normal leans away from the other copy with this
+                                      weight (against the sum of its pair energies),
+                                      and stage 3 keeps the point's normal (its grid
+                                      cannot resolve the part). Only in blocks where
+                                      >= 5 % of the points show it. Seeds 1-5 at 0.5:
+                                      18 rooms 8.01 -> 7.01 % wrong (in-block 7.76 ->
+                                      6.51), 15 depth frames unchanged (3.66), but the
+                                      generated 20K-point test room 9.3 -> 12.5 %:
+                                      opt-in until that is understood. 0 = off (0) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Stage 2 helper: which face of a thin two-sided part a point lies on. */
+#ifndef DACPO_SHEET_SIDE_H
+#define DACPO_SHEET_SIDE_H
+
+#include "dacpo_internal.h"
+
+/* side[i] in [-1, 1] for n points of one block: the sign says along which
+ * direction of the axis nrm[i] the point's face looks (+1: +nrm[i], away from
+ * the other face), the magnitude how sure the test is (0: no second face seen,
+ * or the offsets are not clearly two-valued).
+ *
+ * xyz, nrm: 3n doubles (unit axes); nb: n x K nearest neighbours of every point
+ * (self excluded, nearest first; rows padded with the point itself are allowed);
+ * spacing: the block's typical nearest-neighbour distance.
+ * face (n x K, may be NULL): where the cue fires, face[i K + t] = +1 if nb[i K + t]
+ * lies on point i's own face, -1 on the other face, 0 if it was not part of the
+ * fit (axis not parallel, beyond the first 24); 0 everywhere else.
+ * strict (may be NULL): the number of points where the stricter first test
+ * (one quadric) fires - the share that tells a block with thin parts from a
+ * single depth frame's block.
+ *
+ * Failures: none beyond INVALID_ARGUMENT for NULL arrays (pure arithmetic). */
+dacpo_status
+dacpo_sheet_side(const double* xyz,
+                 const double* nrm,
+                 size_t n,
+                 const int32_t* nb,
+                 size_t K,
+                 double spacing,
+                 double* side,
+                 int8_t* face,
+                 size_t* strict,
+                 dacpo_err* err);
+
+#endif

@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Stage 2 helper: the side of a thin two-sided part a point lies on
+// (dacpo_sheet_side.c). Known answers on generated sheets at spacing h: two
+// faces of a board 0.5 h thick (the cue must fire and be right), and single
+// surfaces it must stay silent on (flat, noisy, curved, and the side-by-side
+// terraces of a quantised depth image).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+extern "C" {
+#include "dacpo_kdtree.h"
+#include "dacpo_sheet_side.h"
+}
+
+namespace {
+
+const double kH = 0.02; // sampling spacing of every face
+const size_t kK = 32;   // neighbours per point, as stage 2 lists them
+
+struct Cloud {
+  std::vector<double> xyz, axis; // axis: unit, sign random (as PCA gives)
+  std::vector<int> face;         // +1 / -1: which face (0: single surface)
+  std::vector<double> out;       // true normal
+  void
+  add(double x, double y, double z, const double n[3], int f, dacpo_rng* rng)
+  {
+    xyz.insert(xyz.end(), {x, y, z});
+    const double s = dacpo_rng_uniform(rng) < 0.5 ? -1.0 : 1.0;
+    axis.insert(axis.end(), {s * n[0], s * n[1], s * n[2]});
+    out.insert(out.end(), {n[0], n[1], n[2]});
+    face.push_back(f);
+  }
+  size_t
+  size() const
+  {
+    return face.size();
+  }
+};
+
+double
+gauss(dacpo_rng* rng)
+{
+  const double u = dacpo_rng_uniform(rng) + 1e-300, v = dacpo_rng_uniform(rng);
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(6.283185307179586 * v);
+}
+
+// Jittered grid over [0, L)^2 at spacing kH, z = height(x, y) + noise.
+template <class Height>
+void
+addSheet(Cloud& c, double L, Height height, int f, double sigma, uint64_t seed)
+{
+  dacpo_rng rng;
+  dacpo_rng_seed(&rng, seed, 7);
+  const int m = (int)(L / kH);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double x = (i + 0.3 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+      const double y = (j + 0.3 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+      double n[3] = {0.0, 0.0, 1.0};
+      const double z = height(x, y, n, f) + sigma * gauss(&rng);
+      c.add(x, y, z, n, f, &rng);
+    }
+}
+
+// Runs the cue; returns side[] and fills face labels.
+std::vector<double>
+runCue(const Cloud& c, std::vector<int8_t>* face_out, std::vector<int32_t>* nb_out)
+{
+  const size_t n = c.size();
+  dacpo_err err{};
+  dacpo_kdtree* tree = nullptr;
+  EXPECT_EQ(dacpo_kdtree_build(c.xyz.data(), n, &tree, &err), DACPO_OK);
+  std::vector<int32_t> nb(n * kK), buf(kK + 1);
+  std::vector<double> dist(kK + 1);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t got =
+        dacpo_kdtree_knn(tree, &c.xyz[3 * i], kK + 1, buf.data(), dist.data());
+    size_t t = 0;
+    for (size_t f = 0; f < got && t < kK; ++f)
+      if ((size_t)buf[f] != i)
+        nb[i * kK + t++] = buf[f];
+    for (; t < kK; ++t)
+      nb[i * kK + t] = (int32_t)i;
+  }
+  dacpo_kdtree_free(tree);
+  std::vector<double> side(n);
+  std::vector<int8_t> face(n * kK);
+  EXPECT_EQ(dacpo_sheet_side(c.xyz.data(),
+                             c.axis.data(),
+                             n,
+                             nb.data(),
+                             kK,
+                             kH,
+                             side.data(),
+                             face.data(),
+                             nullptr,
+                             &err),
+            DACPO_OK);
+  if (face_out)
+    *face_out = face;
+  if (nb_out)
+    *nb_out = nb;
+  return side;
+}
+
+double
+firedShare(const std::vector<double>& side)
+{
+  size_t f = 0;
+  for (double s : side)
+    f += s != 0.0;
+  return (double)f / (double)side.size();
+}
+
+double
+flat(double, double, double* n, int)
+{
+  n[0] = n[1] = 0.0;
+  n[2] = 1.0;
+  return 0.0;
+}
+
+} // namespace
+
+TEST(DacpoSheetSide, BoardThinnerThanTheSpacing)
+{
+  // A 0.5 h board: upper face normal +z at z = t, lower face normal -z at 0.
+  const double t = 0.5 * kH;
+  Cloud c;
+  addSheet(
+      c,
+      0.6,
+      [t](double, double, double* n, int) {
+        n[2] = 1.0;
+        return t;
+      },
+      1,
+      0.0,
+      1);
+  addSheet(
+      c,
+      0.6,
+      [](double, double, double* n, int) {
+        n[2] = -1.0;
+        return 0.0;
+      },
+      -1,
+      0.0,
+      2);
+  std::vector<int8_t> face;
+  std::vector<int32_t> nb;
+  const std::vector<double> side = runCue(c, &face, &nb);
+  size_t fired = 0, right = 0, labels = 0, labels_right = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (side[i] == 0.0)
+      continue;
+    ++fired;
+    // side > 0: the face looks along +axis
+    const double* a = &c.axis[3 * i];
+    const double* o = &c.out[3 * i];
+    right += (side[i] > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
+    for (size_t k = 0; k < kK; ++k) {
+      if (face[i * kK + k] == 0)
+        continue;
+      ++labels;
+      const size_t j = (size_t)nb[i * kK + k];
+      labels_right += (face[i * kK + k] > 0) == (c.face[i] == c.face[j]);
+    }
+  }
+  printf("board 0.5 h: cue fires on %.2f %% of the points, right on %.2f %%; "
+         "%.3f %% of %zu face labels right\n",
+         100.0 * fired / c.size(),
+         100.0 * right / fired,
+         100.0 * labels_right / labels,
+         labels);
+  EXPECT_GE((double)fired / (double)c.size(), 0.90);
+  EXPECT_EQ(right, fired);
+  EXPECT_GT(labels, 10 * fired);
+  EXPECT_GE((double)labels_right, 0.995 * (double)labels); // the rim mixes a few
+}
+
+TEST(DacpoSheetSide, SilentOnSingleSurfaces)
+{
+  struct Case {
+    const char* name;
+    double fired_max;
+    Cloud cloud;
+  };
+  std::vector<Case> cases;
+  {
+    Cloud c;
+    addSheet(c, 0.6, flat, 0, 0.0, 3);
+    cases.push_back({"flat", 0.0, c});
+  }
+  {
+    Cloud c; // depth-like noise, 0.3 spacing
+    addSheet(c, 0.6, flat, 0, 0.3 * kH, 4);
+    cases.push_back({"noisy", 0.01, c});
+  }
+  {
+    Cloud c; // a cylinder of radius 5 spacings around the x axis
+    const double R = 5.0 * kH;
+    addSheet(
+        c,
+        0.6,
+        [R](double, double y, double* n, int) {
+          const double a = y / R; // arc length -> angle
+          n[0] = 0.0;
+          n[1] = std::sin(a);
+          n[2] = std::cos(a);
+          return R * std::cos(a) - R;
+        },
+        0,
+        0.0,
+        5);
+    // the sheet's y is arc length; place the points on the circle
+    for (size_t i = 0; i < c.size(); ++i) {
+      const double a = c.xyz[3 * i + 1] / R;
+      c.xyz[3 * i + 1] = R * std::sin(a);
+    }
+    cases.push_back({"cylinder", 0.0, c});
+  }
+  {
+    Cloud c; // terraces: strips 3.6 spacings wide, each 0.5 spacing higher
+    const double w = 3.6 * kH;
+    addSheet(
+        c,
+        0.6,
+        [w](double x, double, double* n, int) {
+          n[2] = 1.0;
+          return 0.5 * kH * std::floor(x / w);
+        },
+        0,
+        0.0,
+        6);
+    cases.push_back({"terraces", 0.02, c});
+  }
+  for (const Case& k : cases) {
+    const double share = firedShare(runCue(k.cloud, nullptr, nullptr));
+    printf("%-9s cue fires on %.2f %% of the points\n", k.name, 100.0 * share);
+    EXPECT_LE(share, k.fired_max) << k.name;
+  }
+}
+
+TEST(DacpoSheetSide, EmptyAndNullInput)
+{
+  dacpo_err err{};
+  EXPECT_EQ(dacpo_sheet_side(
+                nullptr, nullptr, 0, nullptr, kK, kH, nullptr, nullptr, nullptr, &err),
+            DACPO_OK);
+  double side = 0.0;
+  EXPECT_EQ(dacpo_sheet_side(
+                nullptr, nullptr, 1, nullptr, kK, kH, &side, nullptr, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+}
