@@ -96,7 +96,7 @@ dacpo_params_init(dacpo_params* p)
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
   p->dipole_layers = 2.0;
-  p->dipole_sides = 0.0;
+  p->dipole_sides = 0.001;
 }
 
 static dacpo_status

@@ -218,11 +218,13 @@ typedef struct dacpo_params {
                                       weight (against the sum of its pair energies),
                                       and stage 3 keeps the point's normal (its grid
                                       cannot resolve the part). Only in blocks where
-                                      >= 5 % of the points show it. Seeds 1-5 at 0.5:
-                                      18 rooms 8.01 -> 7.01 % wrong (in-block 7.76 ->
-                                      6.51), 15 depth frames unchanged (3.66), but the
-                                      generated 20K-point test room 9.3 -> 12.5 %:
-                                      opt-in until that is understood. 0 = off (0) */
+                                      >= 5 % of the points show it. Any value > 0
+                                      turns the cue on; 0.001 (default) is pairs and
+                                      stage 3 only (the field just breaks ties).
+                                      Seeds 1-5, 18 rooms / 15 depth frames, % wrong:
+                                      off 8.01 / 3.66, 0.001 7.40 / 3.66, 0.5 7.01 /
+                                      3.66 (larger seed spread, a generated 20K room
+                                      7.6-13.1 %). 0 = off (0.001) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -577,8 +577,8 @@ public:
     return params_.dipole_layers;
   }
 
-  /** \brief Parts thinner than the point spacing (default 0 = off; try 0.5 on
-   * scans of furnished rooms): where the neighbours of a point with parallel
+  /** \brief Parts thinner than the point spacing (default 0.001, 0 = off; 0.5
+   * for a stronger field): where the neighbours of a point with parallel
    * axes lie on two parallel copies of one smooth surface over 0.3 spacing
    * apart, the pairs across the copies face opposite ways, the point's normal
    * leans away from the other copy with this weight (against the sum of its
