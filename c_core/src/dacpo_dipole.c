@@ -333,6 +333,19 @@ layer_pair(const two_sheet_scale* ts,
   return (oa < ob ? oa : ob) > ts->layers * local;
 }
 
+/* Two sheets of one thin part face opposite ways: e = -3 (n.m)/|r|^3, three
+ * times the coplanar magnitude of Eq. 1, so the other sheet outweighs the
+ * far-field alignment of its remaining neighbours (measured: 1x gained half as
+ * much on the rooms). Symmetric in (p, n) and (q, m). */
+static double
+two_sheet_energy(const double* p, const double* n, const double* q, const double* m)
+{
+  const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  const double nm = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+  return -DACPO_TWO_SHEET_WEIGHT * nm / (rr * sqrt(rr));
+}
+
 /* Eq. 4's cached energy of neighbour j acting on point i (axes unflipped):
  * Eq. 1-2 with constant c, except for two sheets of one thin part (opposite)
  * and layers of a one-sided surface (c = 1); pairs within the noise band
@@ -352,14 +365,7 @@ pair_energy(const two_sheet_scale* ts,
   const double* ni = nrm + 3 * i;
   if (ts->sheet && ts->sheet[i] && ts->sheet[j] &&
       two_sheet_pair(ts, p, nj, j, q, ni, i)) {
-    /* two sheets of one thin part face opposite ways: e = -3 (n_j.n_i)/|r|^3,
-     * three times the coplanar magnitude of Eq. 1, so the other sheet
-     * outweighs the far-field alignment of its remaining neighbours
-     * (measured: 1x gained half as much on the rooms) */
-    const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-    const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    const double nm = ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2];
-    return -DACPO_TWO_SHEET_WEIGHT * nm / (rr * sqrt(rr));
+    return two_sheet_energy(p, nj, q, ni);
   }
   if (ts->layers > 0.0 && layer_pair(ts, p, nj, j, q, ni, i))
     return dacpo_dipole_energy(p, nj, q, ni, 1.0);
@@ -423,13 +429,8 @@ side_pairs(const double* xyz,
       if (face[i * K + t] >= 0)
         continue;
       const size_t j = (size_t)wk->nb[i * K + t];
-      const double* p = xyz + 3 * i;
-      const double* q = xyz + 3 * j;
-      const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-      const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-      const double nm = nrm[3 * i] * nrm[3 * j] + nrm[3 * i + 1] * nrm[3 * j + 1] +
-                        nrm[3 * i + 2] * nrm[3 * j + 2];
-      const double opp = -DACPO_TWO_SHEET_WEIGHT * nm / (rr * sqrt(rr));
+      const double opp =
+          two_sheet_energy(xyz + 3 * j, nrm + 3 * j, xyz + 3 * i, nrm + 3 * i);
       double* w = &wk->w[i * K + t];
       *w += conf * (opp - *w);
       for (size_t s = 0; s < K; ++s)
