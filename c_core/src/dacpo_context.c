@@ -91,7 +91,8 @@ dacpo_params_init(dacpo_params* p)
   p->vcr_views = 12;
   p->vcr_perspective = 0;
   p->vcr_boundary_factor = 1;
-  p->dipole_restarts = 4;
+  p->dipole_restarts = 16;
+  p->dipole_restart_vote = 1;
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
@@ -156,6 +157,11 @@ check_dipole_counts(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_restarts must be in [1, 64] (got %zu)",
                      p->dipole_restarts);
+  if (p->dipole_restart_vote != 0 && p->dipole_restart_vote != 1)
+    return bad_field(message,
+                     size,
+                     "dipole_restart_vote must be 0 or 1 (got %d)",
+                     p->dipole_restart_vote);
   return DACPO_OK;
 }
 

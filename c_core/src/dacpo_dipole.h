@@ -13,8 +13,9 @@ typedef struct dacpo_dipole_params {
   size_t graph_k;   /* k of the BFS graph */
   int final_sweep;  /* re-decision sweeps with all neighbours placed (until
                        none changes, at most this many; 0 = none) */
-  size_t restarts;  /* independent runs of the M orders; the one with the
-                       highest block energy is kept (0 or 1 = one run) */
+  size_t restarts;  /* independent runs of the M orders (0 or 1 = one run) */
+  int restart_vote; /* 1: the restarts are voted point by point; 0: the one
+                       with the highest block energy is kept */
   uint64_t seed;
   uint64_t stream;   /* e.g. the block id: independent of thread count */
   double noise_band; /* 0 = off; else pairs whose offsets along both normals are

@@ -212,6 +212,7 @@ block_dipole_params(const run_state* s, size_t b, uint8_t* thin)
   dp.two_sheet = s->p.dipole_two_sheet;
   dp.layers = s->p.dipole_layers;
   dp.restarts = s->p.dipole_restarts;
+  dp.restart_vote = s->p.dipole_restart_vote;
   dp.sides = s->p.dipole_sides;
   dp.thin_out = thin;
   return dp;

@@ -57,7 +57,7 @@
 #define SIDE_MIN_CLUSTER 0.25
 #define SIDE_MAX_LATERAL 0.5 /* x mean lateral distance */
 #define SIDE_MIN_GAP 0.3     /* x spacing */
-     /* x spacing: beyond, the two-sheet rule */
+                             /* x spacing: beyond, the two-sheet rule */
 #define SIDE_SEP_START 5.0
 #define SIDE_SEP_FULL 8.0
 #define SIDE_FIT_ROUNDS 3
@@ -250,8 +250,13 @@ one_surface_split(
  * copy with under 25 % of the points, gap under SIDE_MIN_GAP spacings, or
  * copies beside each other); l[k] > 0 then means the copy on the +axis side. */
 static double
-two_copy_fit(
-    const double* u, const double* v, const double* z, int m, double spacing, double* l)
+two_copy_fit(const double* u,
+             const double* v,
+             const double* z,
+             int m,
+             double spacing,
+             double* l,
+             double* gap_out)
 {
   double r[SIDE_NEIGHBORS + 1], c[7], gap = 0.0, sep = 0.0;
   const int kmin = (int)ceil(SIDE_MIN_CLUSTER * (double)m);
@@ -281,6 +286,7 @@ two_copy_fit(
       !faces_overlap(u, v, l, m))
     return 0.0;
   const double conf = (sep - SIDE_SEP_START) / (SIDE_SEP_FULL - SIDE_SEP_START);
+  *gap_out = gap;
   return conf < 1.0 ? conf : 1.0;
 }
 
@@ -335,10 +341,29 @@ point_side(const double* xyz,
   if (split < 0)
     return 0.0;
   *strict = split;
-  const double conf = two_copy_fit(u, v, z, m, spacing, l);
-  if (conf > 0.0 && face)
+  double gap = 0.0;
+  const double conf = two_copy_fit(u, v, z, m, spacing, l, &gap);
+  if (conf > 0.0 && face) {
     for (int k = 1; k < m; ++k)
       face[slot[k]] = (l[k] > 0.0) == (l[0] > 0.0) ? 1 : -1;
+    /* A neighbour beyond the other face (not parallel, so not in the fit) is
+     * hidden from this face by the part itself: a wall a shelf board stands
+     * on, seen through the board. Its Eq. 1 pair would relate this face to
+     * the other face's side of the wall, the wrong way round. */
+    const double look = l[0] > 0.0 ? 1.0 : -1.0;
+    for (size_t t = 0; t < K; ++t) {
+      const size_t j = (size_t)row[t];
+      const double* b = nrm + 3 * j;
+      if (j == i || face[t] != 0 ||
+          fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) > SIDE_MIN_COS)
+        continue;
+      const double* q = xyz + 3 * j;
+      const double off =
+          (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
+      if (look * off < -gap)
+        face[t] = SIDE_HIDDEN;
+    }
+  }
   return l[0] > 0.0 ? conf : -conf;
 }
 

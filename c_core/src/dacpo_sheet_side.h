@@ -15,12 +15,15 @@
  * spacing: the block's typical nearest-neighbour distance.
  * face (n x K, may be NULL): where the cue fires, face[i K + t] = +1 if nb[i K + t]
  * lies on point i's own face, -1 on the other face, 0 if it was not part of the
- * fit (axis not parallel, beyond the first 24); 0 everywhere else.
+ * fit (axis not parallel, beyond the first 24), SIDE_HIDDEN if it lies beyond
+ * the other face (the part hides it from point i's face); 0 everywhere else.
  * strict (may be NULL): the number of points where the stricter first test
  * (one quadric) fires - the share that tells a block with thin parts from a
  * single depth frame's block.
  *
  * Failures: none beyond INVALID_ARGUMENT for NULL arrays (pure arithmetic). */
+#define SIDE_HIDDEN (-2)
+
 dacpo_status
 dacpo_sheet_side(const double* xyz,
                  const double* nrm,

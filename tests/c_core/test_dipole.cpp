@@ -4,6 +4,7 @@
 // normals that were randomly flipped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -76,7 +77,8 @@ pipeline_params()
 {
   dacpo_dipole_params p = default_params();
   p.c = 1.5;
-  p.restarts = 4;
+  p.restarts = 16;
+  p.restart_vote = 1;
   p.final_sweep = 10;
   p.two_sheet = 3.0;
   return p;
@@ -171,6 +173,40 @@ thin_board(size_t side, double h, uint64_t seed, double gap = 0.0)
               0.0,
               nz);
   }
+  s.scramble(seed);
+  return s;
+}
+
+// A bookcase seen from the front: a back panel (z = 0, normal +z) with
+// `boards` vertical dividers 0.5 h thick standing on it (faces at x_k -+ h/4,
+// normals -x / +x, depth 8 h), at spacing h.
+Shape
+shelves_on_panel(size_t boards, double h, uint64_t seed)
+{
+  Shape s;
+  dacpo_rng rng;
+  dacpo_rng_seed(&rng, seed, 5);
+  const double t = 0.5 * h, pitch = 12.0 * h;
+  const size_t across = (size_t)((double)(boards + 1) * pitch / h), tall = 30;
+  for (size_t i = 0; i < across; ++i)
+    for (size_t j = 0; j < tall; ++j) {
+      const double x = (i + 0.5) * h + jitter(&rng, 0.5 * h);
+      bool under = false; // the boards cover the panel under them
+      for (size_t k = 1; k <= boards; ++k)
+        under = under || std::fabs(x - k * pitch) < 0.5 * t;
+      if (!under)
+        s.add(x, j * h + jitter(&rng, 0.5 * h), jitter(&rng, 0.02 * h), 0.0, 0.0, 1.0);
+    }
+  for (size_t k = 1; k <= boards; ++k)
+    for (int f = -1; f <= 1; f += 2)
+      for (size_t i = 0; i < 8; ++i)
+        for (size_t j = 0; j < tall; ++j)
+          s.add(k * pitch + f * 0.5 * t + jitter(&rng, 0.02 * h),
+                j * h + jitter(&rng, 0.5 * h),
+                (i + 1.0) * h + jitter(&rng, 0.5 * h),
+                (double)f,
+                0.0,
+                0.0);
   s.scramble(seed);
   return s;
 }
@@ -403,6 +439,57 @@ TEST(DacpoDipole, SideCueSeparatesFacesUnderOneSpacing)
     EXPECT_EQ(t, 0);
 }
 
+TEST(DacpoDipole, ShelvesOnAPanelFaceOutOfTheBoards)
+{
+  // Dividers 0.5 spacing thick standing on a back panel. Near the panel, Eq. 1
+  // relates each face of a board to the panel on both sides of it, and the
+  // panel beyond the other face says "turn over". The side cue marks the panel
+  // behind the board as hidden from that face and drops those pairs. Measured
+  // over seeds 1-6 (8 restarts): without the hidden pairs min 0.9715, mean
+  // 0.9938; with them min 0.9882, mean 0.9974. (At 16 restarts the vote hides
+  // the difference: 0.9877 / 0.9969 against 0.9882 / 0.9970.)
+  dacpo_dipole_params p = pipeline_params();
+  p.sides = 0.001;
+  p.restarts = 8;
+  double sum = 0.0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    const Shape s = shelves_on_panel(4, 0.01, seed);
+    p.seed = seed;
+    const double right = orient_score(s, p);
+    EXPECT_GE(right, 0.985) << seed;
+    sum += right;
+  }
+  EXPECT_GE(sum / 6.0, 0.995);
+}
+
+TEST(DacpoDipole, IslandsOfABlockTakeTheFieldOfThePlacedPoints)
+{
+  // Two coplanar patches 20 patch widths apart in one block (a component
+  // joined by a bridge, or a part beyond every neighbourhood): no k-NN pair
+  // joins them, and a BFS tree starting on the second patch used to take an
+  // arbitrary sign, so the restarts voted on a coin. The Eq. 1 field of the
+  // placed patch says "same way" (n.m / r^3 > 0 for r along the plane).
+  const Shape a = plane_patch(20, 0.01, 5);
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    Shape s;
+    for (int copy = 0; copy < 2; ++copy)
+      for (size_t i = 0; i < a.size(); ++i)
+        s.add(a.xyz[3 * i] + copy * 4.0,
+              a.xyz[3 * i + 1],
+              a.xyz[3 * i + 2],
+              a.truth[3 * i],
+              a.truth[3 * i + 1],
+              a.truth[3 * i + 2]);
+    s.scramble(seed);
+    for (int vote = 0; vote <= 1; ++vote) {
+      dacpo_dipole_params p = pipeline_params();
+      p.seed = seed;
+      p.restart_vote = vote;
+      EXPECT_EQ(orient_score(s, p), 1.0) << seed << " vote " << vote;
+    }
+  }
+}
+
 TEST(DacpoDipole, VotingOverOrdersBeatsOneOrder)
 {
   // With c = 4 on the noisy half-cylinder single greedy orders flip patches; the
@@ -508,4 +595,30 @@ TEST(DacpoDipole, TimingReport)
     EXPECT_LT(t, 2.0); // generous: catches accidental quadratic work only
     EXPECT_EQ(score(s, sign), 1.0);
   }
+}
+TEST(DacpoDipole, RestartVoteHoldsOnEverySeed)
+{
+  // Shelves on a panel without the side cue: the boards' relation to the panel
+  // is weak, and which restart has the highest block energy is close to a coin
+  // toss. Measured over run seeds 1-8 (8 restarts): keeping the highest-energy
+  // restart gave 0.686-0.921 right (mean 0.850), the point-wise vote
+  // 0.857-0.918 (mean 0.891).
+  const Shape s = shelves_on_panel(4, 0.01, 3);
+  dacpo_dipole_params p = pipeline_params();
+  p.restarts = 8;
+  double lo[2] = {1.0, 1.0}, hi[2] = {0.0, 0.0}, mean[2] = {0.0, 0.0};
+  for (int vote = 0; vote <= 1; ++vote) {
+    p.restart_vote = vote;
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      p.seed = seed;
+      const double right = orient_score(s, p);
+      lo[vote] = std::min(lo[vote], right);
+      hi[vote] = std::max(hi[vote], right);
+      mean[vote] += right / 8.0;
+    }
+  }
+  EXPECT_GE(lo[1], 0.85);
+  EXPECT_LE(hi[1] - lo[1], 0.08);
+  EXPECT_GT(mean[1], mean[0]);
+  EXPECT_GT(lo[1], lo[0]);
 }

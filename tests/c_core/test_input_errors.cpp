@@ -565,6 +565,7 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
        }},
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 0; }},
       {"dipole_restarts", [](dacpo_params* p) { p->dipole_restarts = 65; }},
+      {"dipole_restart_vote", [](dacpo_params* p) { p->dipole_restart_vote = 2; }},
       {"dipole_final_sweep", [](dacpo_params* p) { p->dipole_final_sweep = -1; }},
       {"weak_edge_fraction", [](dacpo_params* p) { p->weak_edge_fraction = -0.5; }},
       {"weak_edge_fraction",

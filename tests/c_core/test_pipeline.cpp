@@ -251,8 +251,9 @@ TEST(DacpoPipeline, TwoRoomsBelowMeasuredError)
   EXPECT_EQ(r.stats.solver_optimal, 1);
 }
 
-// Measured (20K-point room, estimated normals, defaults): seeds 1-5 give 9.31,
-// 11.07, 9.44, 8.96, 9.21 % wrong (spread 2.1 points; most of it on thin
+// Measured (20K-point room, estimated normals, defaults): seeds 1-5 give 8.98,
+// 9.86, 8.83, 8.81, 8.83 % wrong (spread 1.05 points; with 4 restarts kept by
+// energy 9.31, 11.07, 9.44, 8.96, 9.21 %, spread 2.1; most of it on thin
 // furniture inside blocks). Before stage-2 restarts, magnitude-aware edge
 // weights and related parts, single seeds of such rooms swung by up to 22
 // points. The least confident 10 % of the points held 40-44 % of the wrong ones.

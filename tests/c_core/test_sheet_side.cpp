@@ -181,6 +181,81 @@ TEST(DacpoSheetSide, BoardThinnerThanTheSpacing)
   EXPECT_GE((double)labels_right, 0.995 * (double)labels); // the rim mixes a few
 }
 
+// Points of a shelf: a vertical board 0.5 h thick (faces at x = -t/2 and
+// x = +t/2, normals -x / +x) standing on a horizontal panel (z = 0, normal +z)
+// that runs on to both sides of it. Face +1 / -1: the board's +x / -x face,
+// 0: the panel.
+Cloud
+shelfOnPanel(double t)
+{
+  Cloud c;
+  dacpo_rng rng;
+  dacpo_rng_seed(&rng, 11, 3);
+  const double up[3] = {0.0, 0.0, 1.0};
+  const int m = (int)(0.6 / kH);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double x = -0.3 + (i + 0.3 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+      const double y = (j + 0.3 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+      if (std::fabs(x) > 0.5 * t) // the board covers the panel under it
+        c.add(x, y, 0.0, up, 0, &rng);
+    }
+  for (int f = -1; f <= 1; f += 2) {
+    const double n[3] = {(double)f, 0.0, 0.0};
+    for (int i = 0; i < m / 2; ++i)
+      for (int j = 0; j < m; ++j) {
+        const double z = (i + 0.8 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+        const double y = (j + 0.3 + 0.4 * dacpo_rng_uniform(&rng)) * kH;
+        c.add(f * 0.5 * t, y, z, n, f, &rng);
+      }
+  }
+  return c;
+}
+
+TEST(DacpoSheetSide, PanelBehindTheBoardIsHidden)
+{
+  // A face of the board sees the panel on its own side (a concave corner) but
+  // not the panel beyond the other face: the board is in the way. Those pairs
+  // are marked hidden, the ones in front never are.
+  const double t = 0.5 * kH;
+  const Cloud c = shelfOnPanel(t);
+  std::vector<int8_t> face;
+  std::vector<int32_t> nb;
+  const std::vector<double> side = runCue(c, &face, &nb);
+  size_t behind = 0, behind_hidden = 0, front_hidden = 0, board_hidden = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (c.face[i] == 0 || side[i] == 0.0)
+      continue;
+    for (size_t k = 0; k < kK; ++k) {
+      const size_t j = (size_t)nb[i * kK + k];
+      const bool hidden = face[i * kK + k] == SIDE_HIDDEN;
+      if (c.face[j] != 0) {
+        board_hidden += hidden;
+        continue;
+      }
+      // the panel point's x seen from face i's outward normal
+      const double ahead = c.xyz[3 * j] * (double)c.face[i];
+      if (ahead < -t) {
+        ++behind;
+        behind_hidden += hidden;
+      }
+      else if (ahead > 0.0) {
+        front_hidden += hidden;
+      }
+    }
+  }
+  printf("shelf on a panel: %zu panel neighbours behind the board, %zu hidden; "
+         "%zu in front hidden, %zu board neighbours hidden\n",
+         behind,
+         behind_hidden,
+         front_hidden,
+         board_hidden);
+  EXPECT_GT(behind, 100u);
+  EXPECT_GE((double)behind_hidden, 0.95 * (double)behind);
+  EXPECT_EQ(front_hidden, 0u);
+  EXPECT_EQ(board_hidden, 0u);
+}
+
 TEST(DacpoSheetSide, SilentOnSingleSurfaces)
 {
   struct Case {

@@ -277,11 +277,13 @@ same_normals)
     fail "the output lost the double coordinates"
   json=$("$4" "$d/room_out.ply" "$d/moved_out.ply" -json 2>/dev/null) || fail "eval failed"
   # the move itself is not exact in double (a float coordinate of 0.1 m plus
-  # 5.4e6 m is rounded to 1e-9 m), and such perturbations change 0.18 % of the
-  # normals (measured, seeds 2/3); in float the moved room fell apart into 11
-  # components and came out 59 % different
-  holds "$(json_number "$json" wrong_pct)" 0.5 "a <= b" || fail "moved room differs: $json"
-  holds "$(json_number "$json" right_sign_pct)" 99.5 "a >= b" ||
+  # 5.4e6 m is rounded to 1e-9 m), and such perturbations change near-tie
+  # decisions: 0.18 % of the normals with 4 restarts kept by energy, 0.59 %
+  # (117 points in 79 clusters of at most 14, error vs ground truth 7.88 and
+  # 7.85 %) with 16 restarts voted (measured, seeds 2/3); in float the moved
+  # room fell apart into 11 components and came out 59 % different
+  holds "$(json_number "$json" wrong_pct)" 1.0 "a <= b" || fail "moved room differs: $json"
+  holds "$(json_number "$json" right_sign_pct)" 99.0 "a >= b" ||
     fail "moved room sign differs: $json"
   for s in 1e22 1e-23; do
     "$2" "$d/sphere.ply" -scene sphere -n 3000 -scale $s >/dev/null || fail "make_scene -scale failed"

@@ -56,6 +56,7 @@ defaultParams()
   d["vcr_perspective"] = p.vcr_perspective != 0;
   d["vcr_boundary_factor"] = p.vcr_boundary_factor != 0;
   d["dipole_restarts"] = p.dipole_restarts;
+  d["dipole_restart_vote"] = p.dipole_restart_vote;
   d["weak_edge_fraction"] = p.weak_edge_fraction;
   d["sign_policy"] = static_cast<int>(p.sign_policy);
   d["viewpoint"] = py::make_tuple(p.viewpoint[0], p.viewpoint[1], p.viewpoint[2]);
@@ -101,6 +102,7 @@ toParams(const py::dict& d)
   p.vcr_boundary_factor =
       get<bool>(d, "vcr_boundary_factor", p.vcr_boundary_factor != 0) ? 1 : 0;
   p.dipole_restarts = get<size_t>(d, "dipole_restarts", p.dipole_restarts);
+  p.dipole_restart_vote = get<int>(d, "dipole_restart_vote", p.dipole_restart_vote);
   p.weak_edge_fraction = get<double>(d, "weak_edge_fraction", p.weak_edge_fraction);
   p.sign_policy =
       static_cast<dacpo_sign_policy>(get<int>(d, "sign_policy", p.sign_policy));

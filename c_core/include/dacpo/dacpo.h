@@ -174,8 +174,11 @@ typedef struct dacpo_params {
   int vcr_perspective;   /**< 1: perspective projection (paper); 0: orthographic (0) */
   int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
   size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
-                                      each); the one with the highest block energy
-                                      (Eq. 4 summed over all pairs) is kept, 1..64 (4) */
+                                      each), 1..64 (16) */
+  int dipole_restart_vote;       /**< 1: the restarts are voted point by point (each
+                                      flipped as a whole to agree with the vote);
+                                      0: the restart with the highest block energy
+                                      (Eq. 4 summed over all pairs) is kept (1) */
   double weak_edge_fraction;     /**< VIEWPOINT policy: block-graph edges whose
                                       alpha + alpha-bar is below this fraction of the
                                       median edge's do not join blocks into one part;

@@ -370,8 +370,8 @@ public:
     return params_.num_threads;
   }
 
-  /** \brief Independent runs of the dipole stage per block; the most
-   *  self-consistent (highest block energy) is kept (default 4). */
+  /** \brief Independent runs of the dipole stage per block (default 16); see
+   *  setDipoleRestartVote() for how they are combined. */
   void
   setDipoleRestarts(std::size_t restarts)
   {
@@ -382,6 +382,21 @@ public:
   getDipoleRestarts() const
   {
     return params_.dipole_restarts;
+  }
+
+  /** \brief true (default): the restarts are voted point by point, each
+   *  flipped as a whole to agree with the vote; false: the restart with the
+   *  highest block energy (Eq. 4 over all pairs) is kept. */
+  void
+  setDipoleRestartVote(bool vote)
+  {
+    params_.dipole_restart_vote = vote ? 1 : 0;
+  }
+  /** \brief See setDipoleRestartVote(). */
+  bool
+  getDipoleRestartVote() const
+  {
+    return params_.dipole_restart_vote != 0;
   }
 
   /** \brief Block-graph edges with less than this fraction of the median
