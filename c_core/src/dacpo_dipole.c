@@ -634,9 +634,10 @@ dipole_decide(const dipole_work* wk, size_t K, size_t i, const int8_t* s)
  * (an island of the block: a part beyond its neighbourhood, or a component
  * joined by a bridge) would take an arbitrary sign, and the restarts would
  * then vote on a coin. Instead it takes the Eq. 1 field of the points placed
- * so far (plain Eq. 2 pairs, at most DACPO_DIPOLE_FAR_SAMPLES of them, evenly
- * spread over the placement order): the field between parts that see each
- * other only from afar still says which way round they belong. */
+ * so far (plain Eq. 2 pairs; every (placed / DACPO_DIPOLE_FAR_SAMPLES)-th
+ * point of the placement order, so fewer than twice that many): the field
+ * between parts that see each other only from afar still says which way round
+ * they belong. */
 #define DACPO_DIPOLE_FAR_SAMPLES 256
 
 static double
