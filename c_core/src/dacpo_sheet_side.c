@@ -290,9 +290,41 @@ two_copy_fit(const double* u,
   return conf < 1.0 ? conf : 1.0;
 }
 
+/* A neighbour beyond the other face (not parallel, so not in the fit) is
+ * hidden from point i's face by the part itself: a wall a shelf board stands
+ * on, seen through the board. Its Eq. 1 pair would relate this face to the
+ * other face's side of the wall, the wrong way round. look: +1 if the face
+ * looks along +nrm[i]; gap: the distance between the two faces. */
+static void
+mark_hidden(const double* xyz,
+            const double* nrm,
+            size_t i,
+            const int32_t* row,
+            size_t K,
+            double look,
+            double gap,
+            int8_t* face)
+{
+  const double* p = xyz + 3 * i;
+  const double* a = nrm + 3 * i;
+  for (size_t t = 0; t < K; ++t) {
+    const size_t j = (size_t)row[t];
+    const double* b = nrm + 3 * j;
+    if (j == i || face[t] != 0 ||
+        fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) > SIDE_MIN_COS)
+      continue;
+    const double* q = xyz + 3 * j;
+    const double off =
+        (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
+    if (look * off < -gap)
+      face[t] = SIDE_HIDDEN;
+  }
+}
+
 /* The cue of one point (see the file comment); 0 if it does not fire. When it
  * fires and face is not NULL, face[t] = +1 / -1 for the neighbours row[t] on
- * the point's own / the other face (0: not parallel or not considered).
+ * the point's own / the other face, SIDE_HIDDEN beyond the other face
+ * (mark_hidden), 0: not parallel and not hidden, or not considered.
  * *strict = 1 if the first test alone fires. */
 static double
 point_side(const double* xyz,
@@ -346,23 +378,7 @@ point_side(const double* xyz,
   if (conf > 0.0 && face) {
     for (int k = 1; k < m; ++k)
       face[slot[k]] = (l[k] > 0.0) == (l[0] > 0.0) ? 1 : -1;
-    /* A neighbour beyond the other face (not parallel, so not in the fit) is
-     * hidden from this face by the part itself: a wall a shelf board stands
-     * on, seen through the board. Its Eq. 1 pair would relate this face to
-     * the other face's side of the wall, the wrong way round. */
-    const double look = l[0] > 0.0 ? 1.0 : -1.0;
-    for (size_t t = 0; t < K; ++t) {
-      const size_t j = (size_t)row[t];
-      const double* b = nrm + 3 * j;
-      if (j == i || face[t] != 0 ||
-          fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) > SIDE_MIN_COS)
-        continue;
-      const double* q = xyz + 3 * j;
-      const double off =
-          (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
-      if (look * off < -gap)
-        face[t] = SIDE_HIDDEN;
-    }
+    mark_hidden(xyz, nrm, i, row, K, l[0] > 0.0 ? 1.0 : -1.0, gap, face);
   }
   return l[0] > 0.0 ? conf : -conf;
 }
