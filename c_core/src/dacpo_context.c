@@ -98,6 +98,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_two_sheet = 3.0;
   p->dipole_layers = 2.0;
   p->dipole_sides = 0.001;
+  p->cue_anchor = 1.0;
 }
 
 static dacpo_status
@@ -237,6 +238,9 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_sides must be finite and >= 0 (got %g)",
                      p->dipole_sides);
+  if (!(p->cue_anchor >= 0.0) || !isfinite(p->cue_anchor))
+    return bad_field(
+        message, size, "cue_anchor must be finite and >= 0 (got %g)", p->cue_anchor);
   return DACPO_OK;
 }
 

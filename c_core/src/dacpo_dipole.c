@@ -1002,6 +1002,11 @@ dacpo_dipole_orient_confidence(const double* xyz,
   if (params->thin_out)
     for (size_t i = 0; i < n; ++i)
       params->thin_out[i] = wk.unary && wk.unary[i] != 0.0;
+  if (params->cue_out)
+    for (size_t i = 0; i < n; ++i)
+      params->cue_out[i] = !wk.unary || wk.unary[i] == 0.0            ? 0
+                           : (wk.unary[i] > 0.0) == (sign_out[i] > 0) ? 1
+                                                                      : -1;
   if (confidence)
     dipole_confidence(&wk, n, K, R, sign_out, confidence);
   dipole_work_free(&wk);

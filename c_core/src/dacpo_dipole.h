@@ -34,6 +34,9 @@ typedef struct dacpo_dipole_params {
                         side cue fired, i.e. the point lies on a part thinner
                         than the block's Poisson grid resolves (stage 3 keeps
                         its stage-2 normal) */
+  int8_t* cue_out;   /* optional output (n entries, may be NULL): +1 where the
+                        side cue fired and agrees with the returned sign, -1
+                        where it disagrees, 0 elsewhere */
 } dacpo_dipole_params;
 
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for

@@ -52,12 +52,13 @@ typedef struct run_state {
   dacpo_ipsr_stats* ipsr; /* per block */
   double* block_seconds;  /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;         /* per block */
-  float* block_conf;      /* per block: how firmly stage 5 holds its flip */
-  double evidence_scale;  /* median alpha + alpha-bar of the block edges (stage 5) */
-  int32_t* part;          /* n: part of each point (VIEWPOINT policy) */
-  int8_t* part_sign;      /* per part */
-  double* part_conf;      /* per part */
-  double global_sign;     /* +1 or -1: stage 6 */
+  uint32_t* cue_votes;   /* 2 per block: own points whose side cue agrees / disagrees */
+  float* block_conf;     /* per block: how firmly stage 5 holds its flip */
+  double evidence_scale; /* median alpha + alpha-bar of the block edges (stage 5) */
+  int32_t* part;         /* n: part of each point (VIEWPOINT policy) */
+  int8_t* part_sign;     /* per part */
+  double* part_conf;     /* per part */
+  double global_sign;    /* +1 or -1: stage 6 */
   dacpo_ilp_result ilp;
 } run_state;
 
@@ -82,6 +83,7 @@ run_state_free(run_state* s)
   free(s->ipsr);
   free(s->block_seconds);
   free(s->flips);
+  free(s->cue_votes);
   free(s->block_conf);
   free(s->part);
   free(s->part_sign);
@@ -215,6 +217,7 @@ block_dipole_params(const run_state* s, size_t b, uint8_t* thin)
   dp.restart_vote = s->p.dipole_restart_vote;
   dp.sides = s->p.dipole_sides;
   dp.thin_out = thin;
+  dp.cue_out = NULL;
   return dp;
 }
 
@@ -231,8 +234,9 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
   float* conf = dacpo_malloc_array(n, sizeof(float));
   uint8_t* thin = dacpo_malloc_array(n, sizeof(uint8_t));
+  int8_t* cue = dacpo_malloc_array(n, sizeof(int8_t));
   dacpo_status st = DACPO_OK;
-  if (!xyz || !nrm || !sign || !conf || !thin) {
+  if (!xyz || !nrm || !sign || !conf || !thin || !cue) {
     st = DACPO_OOM(err);
     goto done;
   }
@@ -243,10 +247,15 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
     memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
     memcpy(nrm + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
   }
-  const dacpo_dipole_params dp = block_dipole_params(s, b, thin);
+  dacpo_dipole_params dp = block_dipole_params(s, b, thin);
+  dp.cue_out = cue;
   double t0 = dacpo_now();
   st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);
   double t1 = dacpo_now();
+  /* the cue's points keep their stage-2 sign through stage 3 (ip.fixed) */
+  for (size_t i = 0; st == DACPO_OK && i < no; ++i)
+    if (cue[i])
+      s->cue_votes[2 * b + (cue[i] > 0 ? 0 : 1)]++;
   s->block_seconds[2 * b] = t1 - t0;
   if (st != DACPO_OK)
     goto done;
@@ -291,6 +300,7 @@ done:
   free(sign);
   free(conf);
   free(thin);
+  free(cue);
   return st;
 }
 
@@ -341,6 +351,8 @@ block_confidence(run_state* s, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* e
     const double other = same ? ie[e].w_diff : ie[e].w_same;
     for (int side = 0; side < 2; ++side) {
       const size_t b = (size_t)(side ? ie[e].b : ie[e].a);
+      if (b >= nb)
+        continue; /* the cue's anchor node */
       lose[b] += kept - other;
       total[b] += kept + other;
     }
@@ -353,12 +365,83 @@ block_confidence(run_state* s, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* e
   return DACPO_OK;
 }
 
+#define DACPO_CUE_MIN_POINTS 20
+#define DACPO_CUE_SCALE 100.0
+
+/* What the cue says about block b: +1 "as stage 3 left it", -1 "flipped", 0
+ * nothing (cue off, under DACPO_CUE_MIN_POINTS cue points, or a tie);
+ * *points = its cue points. A block whose cue points are split (half wrong
+ * inside, or a noisy cue) still says what most of them say: dropping blocks
+ * whose cue points agreed less than 90 % cost a 100K room 9.24 -> 13.16 %. */
+static int
+cue_sign(const run_state* s, size_t b, double* points)
+{
+  const double agree = (double)s->cue_votes[2 * b];
+  const double against = (double)s->cue_votes[2 * b + 1];
+  *points = agree + against;
+  if (!(s->p.cue_anchor > 0.0) || !(s->p.dipole_sides > 0.0) ||
+      !(*points >= DACPO_CUE_MIN_POINTS) || agree == against)
+    return 0;
+  return agree > against ? 1 : -1;
+}
+
+/* Stage 5 anchor: the side cue is an absolute sign (the faces of a thin part
+ * look away from each other; its points keep their stage-2 sign through
+ * stage 3), so a block where it fired gets an edge to a virtual node that
+ * stands for "not flipped": w_same / w_diff = weight x g x the share of cue
+ * points that agree / disagree, g = m / (m + DACPO_CUE_SCALE) for m cue points
+ * (Eq. 7's ratio, scaled like an edge's amount of evidence). Returns the
+ * number of anchor edges written after the ne block edges. */
+static size_t
+cue_anchor_edges(const run_state* s, dacpo_ilp_edge* ie, size_t ne)
+{
+  const size_t nb = s->blocks.num_blocks;
+  size_t m = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    double cue = 0.0;
+    if (!cue_sign(s, b, &cue))
+      continue;
+    const double agree = (double)s->cue_votes[2 * b];
+    const double against = (double)s->cue_votes[2 * b + 1];
+    const double g = s->p.cue_anchor * cue / (cue + DACPO_CUE_SCALE);
+    ie[ne + m].a = (int32_t)b;
+    ie[ne + m].b = (int32_t)nb;
+    ie[ne + m].w_same = g * agree / cue;
+    ie[ne + m].w_diff = g * against / cue;
+    m++;
+  }
+  return m;
+}
+
+/* The 0-1 program fixes the lowest node of each component, so the anchor node
+ * can end at 1: then every block joined to it is read the other way round. */
+static dacpo_status
+read_anchor(run_state* s, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* err)
+{
+  const size_t nb = s->blocks.num_blocks;
+  if (!s->flips[nb])
+    return DACPO_OK;
+  int32_t* root = dacpo_malloc_array(nb + 1, sizeof(int32_t));
+  if (!root)
+    return DACPO_OOM(err);
+  for (size_t b = 0; b <= nb; ++b)
+    root[b] = (int32_t)b;
+  for (size_t e = 0; e < ne; ++e)
+    dacpo_uf_union(root, ie[e].a, ie[e].b);
+  const int32_t ra = dacpo_uf_find(root, (int32_t)nb);
+  for (size_t b = 0; b <= nb; ++b)
+    if (dacpo_uf_find(root, (int32_t)b) == ra)
+      s->flips[b] = (uint8_t)!s->flips[b];
+  free(root);
+  return DACPO_OK;
+}
+
 static dacpo_status
 solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
-  const size_t ne = s->bgraph.num_edges;
-  dacpo_ilp_edge* ie = dacpo_malloc_array(ne, sizeof(dacpo_ilp_edge));
-  s->flips = dacpo_calloc_array(s->blocks.num_blocks, sizeof(uint8_t));
+  const size_t ne = s->bgraph.num_edges, nb = s->blocks.num_blocks;
+  dacpo_ilp_edge* ie = dacpo_malloc_array(ne + nb, sizeof(dacpo_ilp_edge));
+  s->flips = dacpo_calloc_array(nb + 1, sizeof(uint8_t));
   if (!ie || !s->flips) {
     free(ie);
     return DACPO_OOM(err);
@@ -373,16 +456,19 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
     if (be->alpha == 0.0 && be->alpha_bar == 0.0)
       st->zero_weight_edges++;
   }
-  dacpo_status r = dacpo_ilp_solve(s->blocks.num_blocks,
-                                   ne,
+  const size_t na = cue_anchor_edges(s, ie, ne);
+  dacpo_status r = dacpo_ilp_solve(nb + (na > 0),
+                                   ne + na,
                                    ie,
                                    s->p.solver_time_limit,
                                    s->progress,
                                    s->flips,
                                    &s->ilp,
                                    err);
+  if (r == DACPO_OK && na > 0)
+    r = read_anchor(s, ie, ne + na, err);
   if (r == DACPO_OK)
-    r = block_confidence(s, ie, ne, err);
+    r = block_confidence(s, ie, ne + na, err);
   free(ie);
   return r;
 }
@@ -477,6 +563,47 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
   free(size);
   free(comp);
   free(anchor);
+  return DACPO_OK;
+}
+
+/* A part holding blocks the side cue anchored has an absolute sign (stage 5
+ * made its blocks agree with the cue), which the viewpoint vote - a guess at
+ * where the scan was seen from, relative to the largest part - does not
+ * overrule: after stage 6, every other part takes the sign under which its
+ * anchored blocks' cue points agree with it. The largest part keeps stage 6's
+ * sign (free space decides the scene's sign). Measured on room3004 (σ 0.008,
+ * seed 5): cue points right on 97 % of 2,258, yet two weakly joined blocks
+ * holding 1,728 of them came out wrong after the viewpoint vote. */
+static dacpo_status
+parts_follow_the_cue(run_state* s, size_t np, dacpo_err* err)
+{
+  const size_t nb = s->blocks.num_blocks, n = s->cloud.n;
+  double* vote = dacpo_calloc_array(np, sizeof(double));
+  size_t* size = dacpo_calloc_array(np, sizeof(size_t));
+  if (!vote || !size) {
+    free(vote);
+    free(size);
+    return DACPO_OOM(err);
+  }
+  for (size_t b = 0; b < nb; ++b) {
+    double points = 0.0;
+    const int says = cue_sign(s, b, &points);
+    if (!says || s->blocks.own_start[b + 1] == s->blocks.own_start[b])
+      continue;
+    const size_t q = (size_t)s->part[s->blocks.own[s->blocks.own_start[b]]];
+    vote[q] += (double)says * (s->flips[b] ? -1.0 : 1.0) * points;
+  }
+  size_t big = 0;
+  for (size_t i = 0; i < n; ++i)
+    size[s->part[i]]++;
+  for (size_t q = 1; q < np; ++q)
+    if (size[q] > size[big])
+      big = q;
+  for (size_t q = 0; q < np; ++q)
+    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] < 0.0)
+      s->part_sign[q] = (int8_t)-s->part_sign[q];
+  free(vote);
+  free(size);
   return DACPO_OK;
 }
 
@@ -742,6 +869,7 @@ orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
   s->point_conf = dacpo_malloc_array(s->cloud.n, sizeof(float));
   s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
   s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
+  s->cue_votes = dacpo_calloc_array(2 * nb, sizeof(uint32_t));
   const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
   if (want_meshes)
     s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
@@ -749,7 +877,7 @@ orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
   if (want_ring)
     s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
   if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
-      (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
+      !s->cue_votes || (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
     return DACPO_OOM(err);
   DACPO_TRY(
       dacpo_parallel_for(nb,
@@ -856,6 +984,8 @@ run(dacpo_ctx* ctx,
       (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))
     DACPO_TRY(relate_parts(s, st, err));
   DACPO_TRY(choose_global_sign(s, st, err));
+  if (s->part_sign)
+    DACPO_TRY(parts_follow_the_cue(s, st->num_parts, err));
   STAGE_DONE(DACPO_STAGE_ILP);
 
   DACPO_TRY(publish(ctx, s, normals, err));

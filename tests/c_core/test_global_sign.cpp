@@ -15,28 +15,11 @@
 extern "C" {
 #include "dacpo_global_sign.h"
 }
-#include "dacpo_scene.h"
+#include "scene_fixture.hpp"
 
 namespace {
 
-struct Scene {
-  dacpo_scene s{};
-  Scene(unsigned kind, size_t points, uint64_t seed)
-  {
-    dacpo_scene_params sp;
-    dacpo_scene_params_init(&sp);
-    sp.kind = kind;
-    sp.target_points = points;
-    sp.seed = seed;
-    char err[256] = "";
-    ok = dacpo_scene_generate(&sp, &s, err, sizeof(err)) == 0;
-  }
-  Scene(const Scene&) = delete;
-  Scene&
-  operator=(const Scene&) = delete;
-  ~Scene() { dacpo_scene_free(&s); }
-  bool ok = false;
-};
+using Scene = GeneratedScene;
 
 std::vector<double>
 asDouble(const float* v, size_t n, double sign = 1.0)

@@ -584,6 +584,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = HUGE_VAL; }},
       {"dipole_sides", [](dacpo_params* p) { p->dipole_sides = -1.0; }},
       {"dipole_sides", [](dacpo_params* p) { p->dipole_sides = NAN; }},
+      {"cue_anchor", [](dacpo_params* p) { p->cue_anchor = -1.0; }},
+      {"cue_anchor", [](dacpo_params* p) { p->cue_anchor = INFINITY; }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},
   };
   auto ctx = makeCtx();

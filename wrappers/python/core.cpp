@@ -51,6 +51,7 @@ defaultParams()
   d["dipole_two_sheet"] = p.dipole_two_sheet;
   d["dipole_layers"] = p.dipole_layers;
   d["dipole_sides"] = p.dipole_sides;
+  d["cue_anchor"] = p.cue_anchor;
   d["vcr_image_size"] = p.vcr_image_size;
   d["vcr_views"] = p.vcr_views;
   d["vcr_perspective"] = p.vcr_perspective != 0;
@@ -96,6 +97,7 @@ toParams(const py::dict& d)
   p.dipole_two_sheet = get<double>(d, "dipole_two_sheet", p.dipole_two_sheet);
   p.dipole_layers = get<double>(d, "dipole_layers", p.dipole_layers);
   p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
+  p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
   p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
   p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
   p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;

@@ -269,6 +269,12 @@ const OptionSpec kOptions[] = {
      "quadric) against its pair energies, 0 = off",
      showNumber<double, &dacpo_params::dipole_sides>,
      setDouble<&dacpo_params::dipole_sides>},
+    {"-cue_anchor",
+     "X",
+     "weight that ties a block where the side cue fired to the\n"
+     "sign the cue gives it in the 0-1 program, 0 = off",
+     showNumber<double, &dacpo_params::cue_anchor>,
+     setDouble<&dacpo_params::cue_anchor>},
     {"-orders",
      "X",
      "randomized dipole propagation orders",

@@ -228,6 +228,17 @@ typedef struct dacpo_params {
                                       off 8.01 / 3.66, 0.001 7.40 / 3.66, 0.5 7.01 /
                                       3.66 (larger seed spread, a generated 20K room
                                       7.6-13.1 %). 0 = off (0.001) */
+  double cue_anchor;             /**< stage 5: the side cue (dipole_sides) is an
+                                      absolute sign - the two faces of a thin part look
+                                      away from each other - so a block where it fired
+                                      on >= 20 of its points is tied to "as stage 3
+                                      left it" (or "flipped", where the cue disagrees)
+                                      with this weight times the share of its cue
+                                      points that agree, scaled like an edge of Eq. 7
+                                      (n / (n + 100) for n cue points). Without it the
+                                      0-1 program trusted the seam evidence of a block
+                                      half wrong inside and turned a right bookcase
+                                      over. 0 = off (1) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -612,6 +612,22 @@ public:
     return params_.dipole_sides;
   }
 
+  /** \brief Weight of the side cue as an absolute sign in the 0-1 program
+   * (default 1, 0 = off): a block where the cue fired on >= 20 points is tied
+   * to the sign its cue points give it (the faces of a thin part look away from
+   * each other), scaled like an edge. See dacpo_params.cue_anchor. */
+  void
+  setCueAnchor(double weight)
+  {
+    params_.cue_anchor = weight;
+  }
+  /** \brief See setCueAnchor(). */
+  double
+  getCueAnchor() const
+  {
+    return params_.cue_anchor;
+  }
+
   /**
    * \brief Set every core parameter at once. params.k replaces setKSearch();
    * params.estimate_normals is ignored (decided by setInputNormals()).

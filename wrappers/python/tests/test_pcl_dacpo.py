@@ -79,6 +79,9 @@ def test_unknown_parameter_names_the_nearest():
         pcl_dacpo.orient(pts, viewpoint=(0, 0, float("nan")))
     assert pcl_dacpo.default_params()["edge_weight"] == "vcr"
     assert pcl_dacpo.default_params()["k"] == 10
+    assert pcl_dacpo.default_params()["cue_anchor"] == 1.0
+    with pytest.raises(ValueError, match="cue_anchor"):
+        pcl_dacpo.orient(pts, cue_anchor=-1.0)
 
 
 def test_bad_inputs_raise_clear_errors():
