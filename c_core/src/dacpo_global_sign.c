@@ -340,7 +340,7 @@ dacpo_global_sign(const double* xyz,
   dacpo_view_rng_seed(&rng);
   for (size_t k = 0; k < GS_CANDIDATES; ++k) {
     gs_candidate* c = &cand[k];
-    dacpo_view_candidate(&vs, &rng, k, c->v, NULL);
+    dacpo_view_candidate(&vs, &rng, k, c->v);
     double vote;
     (void)dacpo_view_score(vs.p, vs.n, NULL, vs.m, c->v, &vote, 1, &c->dist);
     c->score = fabs(vote) / (double)vs.m;

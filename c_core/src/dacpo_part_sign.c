@@ -100,24 +100,16 @@ part_best_viewpoint(const dacpo_view_sample* vs,
   dacpo_view_rng_seed(&rng);
   double facing = -1.0, best_dist = 0.0;
   for (size_t k = 0; k < DACPO_VIEW_CANDIDATES && vs->m > 0; ++k) {
-    double v[3], base[3];
-    dacpo_view_candidate(vs, &rng, k, v, base);
-    /* the candidate and its mirror through the sample point: the set does not
-     * change when a part (the largest one too) comes out of stages 2-5 the
-     * other way round, so neither does the relation found */
-    for (int mirror = 0; mirror < 2; ++mirror) {
-      if (mirror)
-        for (int d = 0; d < 3; ++d)
-          v[d] = 2.0 * base[d] - v[d];
-      double dist;
-      const double score =
-          dacpo_view_score(vs->p, vs->n, vs->part, vs->m, v, vote, num_parts, &dist);
-      if (score > facing + DACPO_VIEW_TIE ||
-          (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
-        facing = fmax(score, facing);
-        best_dist = dist;
-        memcpy(best_v, v, 3 * sizeof(double));
-      }
+    double v[3];
+    dacpo_view_candidate(vs, &rng, k, v);
+    double dist;
+    const double score =
+        dacpo_view_score(vs->p, vs->n, vs->part, vs->m, v, vote, num_parts, &dist);
+    if (score > facing + DACPO_VIEW_TIE ||
+        (score > facing - DACPO_VIEW_TIE && dist > best_dist)) {
+      facing = fmax(score, facing);
+      best_dist = dist;
+      memcpy(best_v, v, 3 * sizeof(double));
     }
   }
   return facing;
@@ -263,8 +255,7 @@ dacpo_view_rng_seed(dacpo_rng* rng)
 }
 
 void
-dacpo_view_candidate(
-    const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3], double base[3])
+dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3])
 {
   /* sign unknown: either side of the normal, by 1/4 .. 2 scene diameters */
   static const double push[4] = {0.25, 0.5, 1.0, 2.0};
@@ -272,6 +263,4 @@ dacpo_view_candidate(
   const double t = (k & 4u ? -1.0 : 1.0) * push[k % 4] * s->diam;
   for (int d = 0; d < 3; ++d)
     v[d] = s->p[3 * j + d] + t * s->n[3 * j + d];
-  if (base)
-    memcpy(base, s->p + 3 * j, 3 * sizeof(double));
 }

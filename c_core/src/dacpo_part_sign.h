@@ -69,12 +69,10 @@ dacpo_view_score(const double* sp,
 
 /* Candidate viewpoint k of a sequence that depends only on the sample (rng
  * seeded with dacpo_view_rng_seed): a sample point pushed along either side
- * of its normal by 1/4 .. 2 scene diameters. base (may be NULL): that sample
- * point, so a caller can also try the mirror 2 base - v. */
+ * of its normal by 1/4 .. 2 scene diameters. */
 void
 dacpo_view_rng_seed(dacpo_rng* rng);
 void
-dacpo_view_candidate(
-    const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3], double base[3]);
+dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3]);
 
 #endif
