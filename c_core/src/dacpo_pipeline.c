@@ -457,6 +457,7 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
       st->zero_weight_edges++;
   }
   const size_t na = cue_anchor_edges(s, ie, ne);
+  st->cue_anchored_blocks = na;
   dacpo_status r = dacpo_ilp_solve(nb + (na > 0),
                                    ne + na,
                                    ie,
@@ -576,7 +577,7 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
  * holding 1,728 of them came out wrong when only stage 5 used the cue (the
  * vote and stage 6 related their part the other way): 9.51 -> 11.68 %. */
 static dacpo_status
-parts_follow_the_cue(run_state* s, size_t np, dacpo_err* err)
+parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
 {
   const size_t nb = s->blocks.num_blocks, n = s->cloud.n;
   double* vote = dacpo_calloc_array(np, sizeof(double));
@@ -601,8 +602,10 @@ parts_follow_the_cue(run_state* s, size_t np, dacpo_err* err)
     if (size[q] > size[big])
       big = q;
   for (size_t q = 0; q < np; ++q)
-    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] < 0.0)
+    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] < 0.0) {
       s->part_sign[q] = (int8_t)-s->part_sign[q];
+      ++*turned;
+    }
   free(vote);
   free(size);
   return DACPO_OK;
@@ -986,7 +989,7 @@ run(dacpo_ctx* ctx,
     DACPO_TRY(relate_parts(s, st, err));
   DACPO_TRY(choose_global_sign(s, st, err));
   if (s->part_sign)
-    DACPO_TRY(parts_follow_the_cue(s, st->num_parts, err));
+    DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   STAGE_DONE(DACPO_STAGE_ILP);
 
   DACPO_TRY(publish(ctx, s, normals, err));

@@ -357,6 +357,15 @@ TEST(DacpoPipeline, SideCueAnchorsABlockTheSeamsVoteWrong)
   RecordProperty("wrong_block_percent", std::to_string(flips));
   EXPECT_LT(flips, 5.5);
   EXPECT_LT(wrongPercent(sc, r), 10.5);
+  EXPECT_GT(r.stats.cue_anchored_blocks, 0u);
+  EXPECT_LE(r.stats.cue_anchored_blocks, r.stats.num_blocks);
+
+  // Off: no block is anchored and no part follows the cue.
+  p.cue_anchor = 0.0;
+  Result off = orientScene(sc, p);
+  ASSERT_EQ(off.status, DACPO_OK) << off.error;
+  EXPECT_EQ(off.stats.cue_anchored_blocks, 0u);
+  EXPECT_EQ(off.stats.parts_cue_signed, 0u);
 }
 
 // ---- published results --------------------------------------------------------

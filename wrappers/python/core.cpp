@@ -202,6 +202,8 @@ statsDict(const dacpo_stats* s)
   stats["solver_optimal"] = s->solver_optimal != 0;
   stats["num_parts"] = s->num_parts;
   stats["parts_related"] = s->parts_related;
+  stats["cue_anchored_blocks"] = s->cue_anchored_blocks;
+  stats["parts_cue_signed"] = s->parts_cue_signed;
   stats["view_score"] = s->view_score;
   stats["sign_flipped"] = s->sign_flipped != 0;
   stats["sign_facing"] = s->sign_facing;

@@ -1051,6 +1051,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
+               "cue_anchored=%zu parts_cue_signed=%zu "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1063,6 +1064,8 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.parts_related,
                s.view_score,
                s.flipped_blocks,
+               s.cue_anchored_blocks,
+               s.parts_cue_signed,
                s.sign_flipped,
                s.sign_facing,
                s.sign_enclosed,

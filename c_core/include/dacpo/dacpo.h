@@ -310,22 +310,26 @@ typedef struct dacpo_stats {
    *  summed per-block times. */
   double stage_seconds[DACPO_STAGE_COUNT];
   double total_seconds;
-  size_t peak_block_points; /**< largest block incl. ring */
-  size_t bridges_added;     /**< bridge edges added (DACPO_DISCONNECTED_BRIDGE) */
-  double longest_bridge;    /**< length of the longest bridge edge */
-  size_t num_parts;         /**< DACPO_DISCONNECTED_VIEWPOINT: parts whose sign the
-                                 viewpoint vote set (components, split further at
-                                 weak block edges); 0 if the vote did not run */
-  double view_score;        /**< share of the points that face the inferred viewpoint
-                                 under their part's sign (0 if unused) */
-  size_t parts_related;     /**< parts other than the largest whose sign the vote
-                                 set (confidence > 0) */
-  int sign_flipped;         /**< 1 if the sign policy turned every normal over */
-  double sign_facing;       /**< share of the points facing the viewpoint the sign
-                                 policy used (away from it if enclosed), 0 if KEEP */
-  int sign_enclosed;        /**< FREE_SPACE: 1 if that viewpoint lies inside a
-                                 closed surface (normals point away from it) */
-  double sign_viewpoint[3]; /**< the viewpoint the sign policy used */
+  size_t peak_block_points;   /**< largest block incl. ring */
+  size_t bridges_added;       /**< bridge edges added (DACPO_DISCONNECTED_BRIDGE) */
+  double longest_bridge;      /**< length of the longest bridge edge */
+  size_t num_parts;           /**< DACPO_DISCONNECTED_VIEWPOINT: parts whose sign the
+                                   viewpoint vote set (components, split further at
+                                   weak block edges); 0 if the vote did not run */
+  double view_score;          /**< share of the points that face the inferred viewpoint
+                                   under their part's sign (0 if unused) */
+  size_t parts_related;       /**< parts other than the largest whose sign the vote
+                                   set (confidence > 0) */
+  int sign_flipped;           /**< 1 if the sign policy turned every normal over */
+  double sign_facing;         /**< share of the points facing the viewpoint the sign
+                                   policy used (away from it if enclosed), 0 if KEEP */
+  int sign_enclosed;          /**< FREE_SPACE: 1 if that viewpoint lies inside a
+                                   closed surface (normals point away from it) */
+  double sign_viewpoint[3];   /**< the viewpoint the sign policy used */
+  size_t cue_anchored_blocks; /**< blocks tied to the side cue's sign in stage 5
+                                   (dacpo_params.cue_anchor) */
+  size_t parts_cue_signed;    /**< parts (not the largest) whose sign the cue
+                                   turned after the viewpoint vote and stage 6 */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */
