@@ -68,10 +68,8 @@ dacpo_view_score(const double* sp,
   return m ? total / (double)m : 0.0;
 }
 
-/* Point count of every part into size; returns the largest part (the lowest
- * index among equals). */
-static size_t
-part_largest(const int32_t* part, size_t n, size_t num_parts, size_t* size)
+size_t
+dacpo_part_largest(const int32_t* part, size_t n, size_t num_parts, size_t* size)
 {
   for (size_t i = 0; i < n; ++i)
     size[part[i]]++;
@@ -182,7 +180,7 @@ dacpo_part_signs(const double* xyz,
       dacpo_view_sample_free(&vs);
     return st == DACPO_OK ? DACPO_OOM(err) : st;
   }
-  const size_t big = part_largest(part, n, num_parts, size);
+  const size_t big = dacpo_part_largest(part, n, num_parts, size);
   double best_v[3] = {0.0, 0.0, 0.0};
   const double facing = part_best_viewpoint(&vs, vote, num_parts, best_v);
   if (score_out)

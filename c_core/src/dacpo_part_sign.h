@@ -26,6 +26,11 @@ dacpo_part_signs(const double* xyz,
                  double* score_out,
                  dacpo_err* err);
 
+/* Point count of every part added into size (num_parts entries, zeroed by the
+ * caller); returns the largest part (the lowest index among equals). */
+size_t
+dacpo_part_largest(const int32_t* part, size_t n, size_t num_parts, size_t* size);
+
 /* A strided sample of at most DACPO_VIEW_SAMPLE points (positions, normals,
  * part ids) and the cloud's bounding box: what the viewpoint searches score
  * (here and in dacpo_global_sign.c). part may be NULL (every id 0). */

@@ -595,12 +595,7 @@ parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
     const size_t q = (size_t)s->part[s->blocks.own[s->blocks.own_start[b]]];
     vote[q] += (double)says * (s->flips[b] ? -1.0 : 1.0) * points;
   }
-  size_t big = 0;
-  for (size_t i = 0; i < n; ++i)
-    size[s->part[i]]++;
-  for (size_t q = 1; q < np; ++q)
-    if (size[q] > size[big])
-      big = q;
+  const size_t big = dacpo_part_largest(s->part, n, np, size);
   for (size_t q = 0; q < np; ++q)
     if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] < 0.0) {
       s->part_sign[q] = (int8_t)-s->part_sign[q];
