@@ -57,7 +57,8 @@ dacpo_stage_name(dacpo_stage stage)
                                                        "dipole",
                                                        "ipsr",
                                                        "edge_weights",
-                                                       "ilp"};
+                                                       "ilp",
+                                                       "mesh"};
   if ((int)stage < 0 || stage >= DACPO_STAGE_COUNT)
     return "unknown";
   return names[stage];

@@ -20,6 +20,7 @@
 #include "dacpo_normals.h"
 #include "dacpo_parallel.h"
 #include "dacpo_part_sign.h"
+#include "dacpo_scene_mesh.h"
 #include "dacpo_segment.h"
 #include "dacpo_vcr.h"
 
@@ -49,6 +50,7 @@ typedef struct run_state {
       point_conf; /* n: in-block confidence (stage 2, halved where stage 3 disagreed) */
   double* ring_oriented;  /* 3 per ring entry: each block's normals of its ring */
   dacpo_mesh* meshes;     /* per block, only for VCR weights */
+  dacpo_mesh scene_mesh;  /* keep_mesh: one surface from the final normals */
   dacpo_ipsr_stats* ipsr; /* per block */
   double* block_seconds;  /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;         /* per block */
@@ -75,6 +77,7 @@ run_state_free(run_state* s)
     for (size_t b = 0; b < s->blocks.num_blocks; ++b)
       dacpo_mesh_free(&s->meshes[b]);
   free(s->meshes);
+  dacpo_mesh_free(&s->scene_mesh);
   dacpo_blocks_free(&s->blocks);
   dacpo_block_graph_free(&s->bgraph);
   free(s->oriented);
@@ -695,45 +698,61 @@ choose_global_sign(run_state* s, dacpo_stats* st, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* ---- scene mesh ---------------------------------------------------------- */
+
+/* keep_mesh: one surface over all blocks from the normals as they will be
+ * returned (block flips, part signs and the global sign applied). */
+static dacpo_status
+build_scene_mesh(run_state* s, dacpo_err* err)
+{
+  const size_t n = s->cloud.n, nb = s->blocks.num_blocks;
+  double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
+  double* spacing = dacpo_calloc_array(nb ? nb : 1, sizeof(double));
+  dacpo_status status = DACPO_OK;
+  if (!nrm || !spacing)
+    status = DACPO_OOM(err);
+  for (size_t i = 0; i < n && status == DACPO_OK; ++i) {
+    double sign = (s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0) * s->global_sign;
+    if (s->part_sign)
+      sign *= (double)s->part_sign[s->part[i]];
+    for (int d = 0; d < 3; ++d)
+      nrm[3 * i + d] = sign * s->oriented[3 * i + d];
+  }
+  for (size_t b = 0; b < nb && status == DACPO_OK && s->ipsr; ++b)
+    spacing[b] = s->ipsr[b].spacing;
+  if (status == DACPO_OK) {
+    dacpo_scene_mesh_input in = {s->cloud.xyz,
+                                 nrm,
+                                 n,
+                                 &s->blocks,
+                                 spacing,
+                                 DACPO_MIN_IPSR_POINTS,
+                                 (unsigned)s->p.num_threads,
+                                 s->progress};
+    status = dacpo_scene_mesh(&in, &s->scene_mesh, NULL, err);
+  }
+  free(nrm);
+  free(spacing);
+  return status;
+}
+
 /* ---- results ----------------------------------------------------------- */
 
-/* One scene mesh from the block meshes; a flipped block's triangles are
- * re-wound so face normals follow the output normals. */
+/* The scene mesh in the context's float arrays. */
 static dacpo_status
 publish_mesh(dacpo_ctx* ctx, const run_state* s, dacpo_err* err)
 {
-  size_t nv = 0, nt = 0;
-  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
-    nv += s->meshes[b].num_vertices;
-    nt += s->meshes[b].num_triangles;
-  }
-  DACPO_CHECK(err,
-              nv < (size_t)INT32_MAX,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "scene mesh has %zu vertices, more than int32 indices hold",
-              nv);
-  ctx->mesh_vertices = dacpo_malloc_array(3 * nv, sizeof(float));
-  ctx->mesh_triangles = dacpo_malloc_array(3 * nt, sizeof(int32_t));
+  const dacpo_mesh* m = &s->scene_mesh;
+  ctx->mesh_vertices = dacpo_malloc_array(3 * m->num_vertices + 1, sizeof(float));
+  ctx->mesh_triangles = dacpo_malloc_array(3 * m->num_triangles + 1, sizeof(int32_t));
   if (!ctx->mesh_vertices || !ctx->mesh_triangles)
     return DACPO_OOM(err);
-  size_t v0 = 0, t0 = 0;
-  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
-    const dacpo_mesh* m = &s->meshes[b];
-    for (size_t i = 0; i < 3 * m->num_vertices; ++i)
-      ctx->mesh_vertices[3 * v0 + i] = (float)m->vertices[i];
-    const int flip = (s->flips[b] != 0) != (s->global_sign < 0.0);
-    for (size_t t = 0; t < m->num_triangles; ++t) {
-      int32_t* out = ctx->mesh_triangles + 3 * (t0 + t);
-      const int32_t* in = m->triangles + 3 * t;
-      out[0] = in[0] + (int32_t)v0;
-      out[1] = in[flip ? 2 : 1] + (int32_t)v0;
-      out[2] = in[flip ? 1 : 2] + (int32_t)v0;
-    }
-    v0 += m->num_vertices;
-    t0 += m->num_triangles;
-  }
-  ctx->mesh_num_vertices = nv;
-  ctx->mesh_num_triangles = nt;
+  for (size_t i = 0; i < 3 * m->num_vertices; ++i)
+    ctx->mesh_vertices[i] = (float)m->vertices[i];
+  if (m->num_triangles)
+    memcpy(ctx->mesh_triangles, m->triangles, 3 * m->num_triangles * sizeof(int32_t));
+  ctx->mesh_num_vertices = m->num_vertices;
+  ctx->mesh_num_triangles = m->num_triangles;
   return DACPO_OK;
 }
 
@@ -783,7 +802,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 
   /* Everything that can fail comes before the caller's normals are written:
    * they are written only on success. */
-  if (s->p.keep_mesh && s->meshes)
+  if (s->p.keep_mesh)
     DACPO_TRY(publish_mesh(ctx, s, err));
 
   /* The output keeps each input point's own axis (given or PCA) and only takes
@@ -869,7 +888,7 @@ orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
   s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
   s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
   s->cue_votes = dacpo_calloc_array(2 * nb, sizeof(uint32_t));
-  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR || s->p.keep_mesh;
+  const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR;
   if (want_meshes)
     s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
   const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
@@ -986,6 +1005,11 @@ run(dacpo_ctx* ctx,
   if (s->part_sign)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   STAGE_DONE(DACPO_STAGE_ILP);
+
+  if (s->p.keep_mesh) {
+    DACPO_TRY(build_scene_mesh(s, err));
+    STAGE_DONE(DACPO_STAGE_MESH);
+  }
 
   DACPO_TRY(publish(ctx, s, normals, err));
 #undef STAGE_DONE

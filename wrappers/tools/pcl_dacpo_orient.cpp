@@ -200,8 +200,8 @@ const OptionSpec kOptions[] = {
      }},
     {"-mesh",
      "F.ply",
-     "also write the reconstructed surface (trimmed iPSR\n"
-     "block meshes, wound like the output normals)",
+     "also write the reconstructed surface (one mesh over\n"
+     "all blocks from the final normals, wound like them)",
      nullptr,
      setText<&Options::mesh>},
     {"-sign",
@@ -854,8 +854,8 @@ peakRssMb()
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
-/* The reconstructed surface (-mesh): the blocks' trimmed iPSR meshes, wound like
- * the output normals, as binary PLY (vertex x y z, face vertex_indices). */
+/* The reconstructed surface (-mesh): the scene mesh, wound like the output
+ * normals, as binary PLY (vertex x y z, face vertex_indices). */
 bool
 saveMesh(const std::string& filename, const Result& r)
 {
@@ -949,10 +949,6 @@ checkFileOptions(Options& o)
   if (!o.mesh.empty()) {
     if (dacpo_tool::extension(o.mesh) != ".ply") {
       print_error("Error: -mesh needs a .ply file name, got '%s'\n", o.mesh.c_str());
-      return false;
-    }
-    if (!o.params.ipsr_enabled) {
-      print_error("Error: -mesh needs the iPSR stage (drop -no_ipsr)\n");
       return false;
     }
     o.params.keep_mesh = 1;

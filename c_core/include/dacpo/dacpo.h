@@ -72,7 +72,8 @@ typedef enum dacpo_stage {
   DACPO_STAGE_IPSR = 5,         /**< stage 3: iPSR with Neumann Poisson per block */
   DACPO_STAGE_EDGE_WEIGHTS = 6, /**< stage 4: block-pair consistency weights */
   DACPO_STAGE_ILP = 7,          /**< stage 5: 0-1 program over the block graph */
-  DACPO_STAGE_COUNT = 8
+  DACPO_STAGE_MESH = 8, /**< scene mesh from the final normals (keep_mesh only) */
+  DACPO_STAGE_COUNT = 9
 } dacpo_stage;
 
 /** \brief Short name of a stage ("segment", "dipole", ...), never NULL. */
@@ -165,13 +166,12 @@ typedef struct dacpo_params {
                                  Eq. 1; 0 = off, the paper's field (0). With
                                  c = 4 a band of 3 cut the error on a room
                                  with noise 0.008 from 46 % to 10 %. */
-  int keep_mesh;         /**< 1: keep the trimmed stage-3 block meshes, wound to agree
-                              with the final (flipped) normals, as one scene mesh; see
-                              dacpo_ctx_mesh() (0) */
-  size_t vcr_image_size; /**< VCR image side in pixels, in [16, 4096] (400, paper) */
-  size_t vcr_views;      /**< VCR views: 12 = dodecahedron face centres (paper);
-                              other counts use a Fibonacci sphere, [1, 256] (12) */
-  int vcr_perspective;   /**< 1: perspective projection (paper); 0: orthographic (0) */
+  int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
+                                 wound to agree with them; see dacpo_ctx_mesh() (0) */
+  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (400, paper) */
+  size_t vcr_views;         /**< VCR views: 12 = dodecahedron face centres (paper);
+                                 other counts use a Fibonacci sphere, [1, 256] (12) */
+  int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
   int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
   size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
                                       each), 1..64 (16) */
@@ -385,10 +385,12 @@ DACPO_API const float*
 dacpo_ctx_point_confidence(const dacpo_ctx* ctx);
 
 /**
- * \brief Scene mesh of the last successful run with params.keep_mesh = 1: the
- * trimmed iPSR meshes of all blocks (own points only), each block's winding
- * reversed when the block was flipped, so face normals agree with the output
- * normals. Blocks are not stitched together. Arrays are owned by the context.
+ * \brief Scene mesh of the last successful run with params.keep_mesh = 1: one
+ * surface over all blocks, reconstructed after the signs are final (a screened
+ * Poisson indicator per block, joined on one lattice, one marching cubes), so
+ * it has no cracks along block seams and its face normals agree with the
+ * output normals. Open at the scene's rims and holes; blocks of fewer than 32
+ * points add no surface. Arrays are owned by the context.
  * \param[out] vertices     3 floats per vertex (may be NULL)
  * \param[out] num_vertices (may be NULL)
  * \param[out] triangles    3 vertex indices per triangle (may be NULL)

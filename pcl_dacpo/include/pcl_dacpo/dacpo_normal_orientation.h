@@ -528,8 +528,8 @@ public:
     return params_.vcr_boundary_factor != 0;
   }
 
-  /** \brief Keep the reconstructed surface: the trimmed iPSR block meshes, wound to
-   * agree with the output normals (default false); see getMeshVertices(). */
+  /** \brief Keep the reconstructed surface: one mesh over all blocks, rebuilt from
+   * the final normals and wound like them (default false); see getMesh(). */
   void
   setKeepMesh(bool keep)
   {
@@ -736,8 +736,9 @@ public:
 
   /** \brief The scene mesh of the last compute() with setKeepMesh(true) as a
    *  pcl::PolygonMesh (vertex cloud x y z, triangles wound like the output
-   *  normals), ready for pcl::io::savePLYFile or the PCL visualizer. The block
-   *  meshes are not stitched: thin cracks remain along block seams. Returns
+   *  normals), ready for pcl::io::savePLYFile or the PCL visualizer. One
+   *  surface over all blocks: no cracks along block seams; open only at the
+   *  scene's own rims and holes. Returns
    *  false (and leaves \a mesh empty) when there is none. */
   bool
   getMesh(pcl::PolygonMesh& mesh) const
