@@ -845,8 +845,14 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 static size_t
 auto_blocks(size_t n)
 {
-  /* about 2.5K points per block, at most the paper's 200. */
-  size_t b = n / 2500;
+  /* about 1,250 points per block, at most the paper's 200. Halving the block
+   * size (from 2,500) moves decisions a block got wrong inside (a thin part
+   * turned over with the floor around it) to the block graph: seeds 1-5,
+   * frames 3.02 -> 2.38 % (worst 3.86 -> 2.62, largest seed spread 5.13 ->
+   * 2.88), rooms 6.50 -> 6.22 % (worst 7.15 -> 6.58, spread 3.15 -> 1.54);
+   * a quarter (625) gave frames 2.06 % but rooms worse on the worst seed (6.88)
+   * and more block flips (see docs/DESIGN.md). */
+  size_t b = n / 1250;
   if (b < 1)
     b = 1;
   if (b > 200)

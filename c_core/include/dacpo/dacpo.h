@@ -137,7 +137,7 @@ typedef struct dacpo_params {
   int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
                              0: use the given normals as axes (default 0) */
   size_t num_blocks;    /**< target number of blocks; 0 = automatic:
-                             n/2500 clamped to [1, 200] (default 0) */
+                             n/1250 clamped to [1, 200] (default 0) */
   size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
   double dipole_c;      /**< c of paper Eq. 1 (1.5). The paper uses 4 for clean and
                              2 for noisy scans. Larger c keeps the two sides of

@@ -204,7 +204,7 @@ public:
     return params_.normal_k;
   }
 
-  /** \brief Target number of blocks; 0 = automatic, n/2500 in [1, 200] (default 0). */
+  /** \brief Target number of blocks; 0 = automatic, n/1250 in [1, 200] (default 0). */
   void
   setNumberOfBlocks(std::size_t num_blocks)
   {
