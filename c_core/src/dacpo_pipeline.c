@@ -848,7 +848,7 @@ auto_blocks(size_t n)
   /* about 1,250 points per block, at most the paper's 200. Halving the block
    * size (from 2,500) moves decisions a block got wrong inside (a thin part
    * turned over with the floor around it) to the block graph: seeds 1-5,
-   * frames 3.02 -> 2.38 % (worst 3.86 -> 2.62, largest seed spread 5.13 ->
+   * frames 3.02 -> 2.35 % (worst 3.86 -> 2.55, largest seed spread 5.13 ->
    * 2.88), rooms 6.50 -> 6.22 % (worst 7.15 -> 6.58, spread 3.15 -> 1.54);
    * a quarter (625) gave frames 2.06 % but rooms worse on the worst seed (6.88)
    * and more block flips (see docs/DESIGN.md). */
