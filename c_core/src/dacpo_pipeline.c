@@ -729,7 +729,7 @@ build_scene_mesh(run_state* s, dacpo_err* err)
                                  DACPO_MIN_IPSR_POINTS,
                                  (unsigned)s->p.num_threads,
                                  s->progress};
-    status = dacpo_scene_mesh(&in, &s->scene_mesh, NULL, err);
+    status = dacpo_scene_mesh(&in, &s->scene_mesh, err);
   }
   free(nrm);
   free(spacing);

@@ -528,32 +528,6 @@ weld(const lattice* L,
   return s;
 }
 
-/* Edges used by one triangle only. */
-static dacpo_status
-count_boundary_edges(const dacpo_mesh* m, size_t* count, dacpo_err* err)
-{
-  key_map uses = {0};
-  DACPO_TRY(map_init(&uses, 3 * m->num_triangles / 2 + 1, err));
-  int32_t* times = dacpo_calloc_array(3 * m->num_triangles + 1, sizeof(int32_t));
-  dacpo_status s = times ? DACPO_OK : DACPO_OOM(err);
-  for (size_t f = 0; f < m->num_triangles && s == DACPO_OK; ++f)
-    for (int e = 0; e < 3 && s == DACPO_OK; ++e) {
-      uint64_t a = (uint64_t)m->triangles[3 * f + e];
-      uint64_t b = (uint64_t)m->triangles[3 * f + (e + 1) % 3];
-      const uint64_t key = a < b ? (a << 32 | b) : (b << 32 | a);
-      int32_t slot;
-      s = map_put(&uses, key, (int32_t)uses.count, &slot, err);
-      if (s == DACPO_OK)
-        ++times[slot];
-    }
-  *count = 0;
-  for (size_t e = 0; e < uses.count && s == DACPO_OK; ++e)
-    *count += times[e] == 1;
-  free(times);
-  map_free(&uses);
-  return s;
-}
-
 /* ---- the stage ---------------------------------------------------------------- */
 
 static dacpo_status
@@ -628,7 +602,6 @@ extract_tiles(const lattice* L,
               const float* values,
               const dacpo_scene_mesh_input* in,
               dacpo_mesh* out,
-              size_t* num_tiles_out,
               dacpo_err* err)
 {
   tile_job J;
@@ -680,15 +653,11 @@ extract_tiles(const lattice* L,
   free(J.grid_domain);
   free(J.out);
   free(tiles);
-  *num_tiles_out = nt;
   return s;
 }
 
 dacpo_status
-dacpo_scene_mesh(const dacpo_scene_mesh_input* in,
-                 dacpo_mesh* out,
-                 dacpo_scene_mesh_info* info,
-                 dacpo_err* err)
+dacpo_scene_mesh(const dacpo_scene_mesh_input* in, dacpo_mesh* out, dacpo_err* err)
 {
   DACPO_CHECK(err,
               in && out && in->xyz && in->nrm && in->blocks && in->n > 0,
@@ -703,7 +672,6 @@ dacpo_scene_mesh(const dacpo_scene_mesh_input* in,
   block_nodes* bn = dacpo_calloc_array(nb ? nb : 1, sizeof(block_nodes));
   key_map nodes = {0};
   float* values = NULL;
-  size_t num_tiles = 0;
   dacpo_status s = bn ? DACPO_OK : DACPO_OOM(err);
   if (s == DACPO_OK)
     s = scene_spacing(tree, in->xyz, in->n, &spacing, err);
@@ -723,16 +691,7 @@ dacpo_scene_mesh(const dacpo_scene_mesh_input* in,
   }
   free(bn);
   if (s == DACPO_OK)
-    s = extract_tiles(&L, &nodes, values, in, out, &num_tiles, err);
-  size_t boundary = 0;
-  if (s == DACPO_OK && info)
-    s = count_boundary_edges(out, &boundary, err);
-  if (s == DACPO_OK && info) {
-    info->cell = L.cell;
-    info->nodes = nodes.count;
-    info->tiles = num_tiles;
-    info->boundary_edges = boundary;
-  }
+    s = extract_tiles(&L, &nodes, values, in, out, err);
   map_free(&nodes);
   free(values);
   if (s != DACPO_OK)

@@ -10,20 +10,12 @@ typedef struct dacpo_scene_mesh_input {
   const double* xyz; /* 3n distinct points */
   const double* nrm; /* 3n final normals (the caller's signs; need not be unit) */
   size_t n;          /* at least 1 */
-  const dacpo_blocks* blocks; /* own points and rings per block */
-  const double*
-      block_spacing;    /* per block sample spacing, 0 = not known (may be NULL) */
-  size_t min_points;    /* blocks with fewer own + ring points get no surface */
-  unsigned num_threads; /* 0 = all cores */
+  const dacpo_blocks* blocks;  /* own points and rings per block */
+  const double* block_spacing; /* per block spacing, 0 = unknown (may be NULL) */
+  size_t min_points;           /* blocks with fewer own + ring points get no surface */
+  unsigned num_threads;        /* 0 = all cores */
   const dacpo_progress* progress;
 } dacpo_scene_mesh_input;
-
-typedef struct dacpo_scene_mesh_info {
-  double cell;           /* lattice cell edge (the scene's median sample spacing) */
-  size_t nodes;          /* lattice nodes that carry an indicator value */
-  size_t tiles;          /* marching-cubes tiles */
-  size_t boundary_edges; /* edges used by one triangle only (the open rims) */
-} dacpo_scene_mesh_info;
 
 /* Every block solves one screened Poisson problem (paper §4.3, the same solver
  * as stage 3) over its own and ring points with the final normals; every
@@ -31,12 +23,9 @@ typedef struct dacpo_scene_mesh_info {
  * that block's iso-value) of the block that owns its nearest sample. Marching
  * cubes over that one field gives one indexed, consistently wound mesh: faces
  * point along the normals, and triangles of neighbouring blocks share their
- * seam vertices. info may be NULL.
+ * seam vertices.
  * Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, CANCELLED (progress). */
 dacpo_status
-dacpo_scene_mesh(const dacpo_scene_mesh_input* in,
-                 dacpo_mesh* out,
-                 dacpo_scene_mesh_info* info,
-                 dacpo_err* err);
+dacpo_scene_mesh(const dacpo_scene_mesh_input* in, dacpo_mesh* out, dacpo_err* err);
 
 #endif

@@ -163,10 +163,9 @@ TEST(SceneMesh, RefusesMissingInput)
 {
   dacpo_mesh mesh{};
   dacpo_err err{};
-  EXPECT_EQ(dacpo_scene_mesh(nullptr, &mesh, nullptr, &err),
-            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_scene_mesh(nullptr, &mesh, &err), DACPO_ERR_INVALID_ARGUMENT);
   dacpo_scene_mesh_input in{};
-  EXPECT_EQ(dacpo_scene_mesh(&in, &mesh, nullptr, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_scene_mesh(&in, &mesh, &err), DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err.msg).find("scene mesh"), std::string::npos) << err.msg;
   EXPECT_EQ(mesh.num_triangles, 0u);
 }
