@@ -772,10 +772,10 @@ namespace {
 // (even indices: plane A at the origin, odd: plane B), so the component labels
 // are i % 2.
 Cloud
-twoPlanes()
+twoPlanes(double x0 = 100.0)
 {
   Cloud a = plane(30, 30, 0.05, 0.0, 0.0, 21);
-  Cloud b = plane(30, 30, 0.05, 100.0, 0.0, 22);
+  Cloud b = plane(30, 30, 0.05, x0, 0.0, 22);
   Cloud c;
   for (size_t i = 0; i < a.size(); ++i) {
     for (const Cloud* s : {&a, &b}) {
@@ -822,38 +822,42 @@ TEST(DacpoInputErrors, DisconnectedComponentsAreOrientedSeparately)
 
 TEST(DacpoInputErrors, DisconnectedPartsAreRelatedByDefault)
 {
-  // Two planes 100 m apart, each given with random signs: by default the far
-  // part takes the sign under which it faces the same side as the larger one.
-  Cloud c = twoPlanes();
-  for (size_t i = 0; i < c.size(); ++i)
-    if ((i * 2654435761u) % 7 < 3)
-      for (int d = 0; d < 3; ++d)
-        c.nrm[3 * i + d] = -c.nrm[3 * i + d];
-  for (uint64_t seed = 1; seed <= 5; ++seed) {
-    SCOPED_TRACE(seed);
-    auto ctx = makeCtx();
-    dacpo_params p;
-    dacpo_params_init(&p);
-    ASSERT_EQ(p.disconnected, DACPO_DISCONNECTED_VIEWPOINT);
-    p.seed = seed;
-    Cloud out = c;
-    ASSERT_EQ(dacpo_orient(ctx.get(),
-                           &p,
-                           nullptr,
-                           nullptr,
-                           out.xyz.data(),
-                           out.nrm.data(),
-                           out.size()),
-              DACPO_OK)
-        << lastError(ctx.get());
-    const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
-    EXPECT_EQ(st->num_components, 2u);
-    EXPECT_EQ(st->num_parts, 2u);
-    EXPECT_EQ(st->parts_related, 1u);
-    EXPECT_GT(st->view_score, 0.99);
-    for (size_t i = 1; i < out.size(); ++i)
-      ASSERT_EQ(out.nrm[3 * i + 2], out.nrm[2]) << i;
-  }
+  // Two planes 100 m apart, or side by side across a gap of 5 spacings (0.25
+  // m at 0.05 m spacing: no k-NN edge crosses it), each given with random
+  // signs: by default the other part takes the sign under which it faces the
+  // same side as the larger one, for every seed.
+  for (const double x0 : {1.70, 100.0})
+    for (uint64_t seed = 1; seed <= 5; ++seed) {
+      SCOPED_TRACE(seed);
+      SCOPED_TRACE(x0);
+      Cloud c = twoPlanes(x0);
+      for (size_t i = 0; i < c.size(); ++i)
+        if ((i * 2654435761u) % 7 < 3)
+          for (int d = 0; d < 3; ++d)
+            c.nrm[3 * i + d] = -c.nrm[3 * i + d];
+      auto ctx = makeCtx();
+      dacpo_params p;
+      dacpo_params_init(&p);
+      ASSERT_EQ(p.disconnected, DACPO_DISCONNECTED_VIEWPOINT);
+      p.seed = seed;
+      Cloud out = c;
+      ASSERT_EQ(dacpo_orient(ctx.get(),
+                             &p,
+                             nullptr,
+                             nullptr,
+                             out.xyz.data(),
+                             out.nrm.data(),
+                             out.size()),
+                DACPO_OK)
+          << lastError(ctx.get());
+      const dacpo_stats* st = dacpo_ctx_stats(ctx.get());
+      EXPECT_EQ(st->num_components, 2u);
+      EXPECT_EQ(st->num_parts, 2u);
+      EXPECT_EQ(st->parts_related, 1u);
+      EXPECT_GT(st->view_score, 0.99);
+      for (size_t i = 1; i < out.size(); ++i)
+        ASSERT_EQ(out.nrm[3 * i + 2], out.nrm[2]) << i;
+    }
 }
 
 TEST(DacpoInputErrors, DisconnectedPolicyErrorFails)
