@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "dacpo_scene.h"
+#include "scene_fixture.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -40,28 +40,7 @@ makeCtx()
   return CtxPtr(c);
 }
 
-// A generated scene that frees itself.
-struct Scene {
-  dacpo_scene s{};
-  Scene() = default;
-  Scene(const Scene&) = delete;
-  Scene&
-  operator=(const Scene&) = delete;
-  ~Scene() { dacpo_scene_free(&s); }
-};
-
-void
-generate(unsigned kind, size_t points, uint64_t seed, Scene* out)
-{
-  dacpo_scene_params sp;
-  dacpo_scene_params_init(&sp);
-  sp.kind = kind;
-  sp.target_points = points;
-  sp.seed = seed;
-  char err[256] = "";
-  ASSERT_EQ(dacpo_scene_generate(&sp, &out->s, err, sizeof(err)), 0) << err;
-  ASSERT_EQ(out->s.n, points);
-}
+using Scene = GeneratedScene;
 
 // The scene's ground truth with half of the signs flipped.
 std::vector<float>
@@ -208,8 +187,9 @@ logProgress(void* user, dacpo_stage stage, double fraction)
 // (the smallest wall is ~16 % of the points).
 TEST(DacpoPipeline, OpenBoxScrambledNormals)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   Result r = orientScene(sc, defaults());
   ASSERT_EQ(r.status, DACPO_OK) << r.error;
   const double wrong = wrongPercent(sc, r);
@@ -223,8 +203,9 @@ TEST(DacpoPipeline, OpenBoxScrambledNormals)
 
 TEST(DacpoPipeline, OpenBoxEstimatedNormals)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   Result r = orientScene(sc, p);
@@ -240,8 +221,9 @@ TEST(DacpoPipeline, OpenBoxEstimatedNormals)
 // estimated normals. A wrongly flipped wall block alone costs > 3 %.
 TEST(DacpoPipeline, TwoRoomsBelowMeasuredError)
 {
-  Scene sc;
-  generate(DACPO_SCENE_TWO_ROOMS, 30000, 1, &sc);
+  Scene sc(DACPO_SCENE_TWO_ROOMS, 30000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 30000u);
   Result r = orientScene(sc, defaults());
   ASSERT_EQ(r.status, DACPO_OK) << r.error;
   const double wrong = wrongPercent(sc, r);
@@ -259,8 +241,9 @@ TEST(DacpoPipeline, TwoRoomsBelowMeasuredError)
 // points. The least confident 10 % of the points held 40-44 % of the wrong ones.
 TEST(DacpoPipeline, SeedsOneToFiveAgreeOnAGeneratedRoom)
 {
-  Scene sc;
-  generate(DACPO_SCENE_ROOM, 20000, 1, &sc);
+  Scene sc(DACPO_SCENE_ROOM, 20000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 20000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   double lo = 100.0, hi = 0.0;
@@ -345,8 +328,9 @@ wrongBlockPercent(const Scene& sc, const Result& r)
 // cue does not fire.
 TEST(DacpoPipeline, SideCueAnchorsABlockTheSeamsVoteWrong)
 {
-  Scene sc;
-  generate(DACPO_SCENE_ROOM, 100000, 1, &sc);
+  Scene sc(DACPO_SCENE_ROOM, 100000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 100000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   p.seed = 2;
@@ -374,8 +358,9 @@ TEST(DacpoPipeline, SideCueAnchorsABlockTheSeamsVoteWrong)
 // per-point array must follow the input order.
 TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 8000, 2, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 8000, 2);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 8000u);
   const size_t half = sc.s.n, n = 2 * half;
   std::vector<size_t> perm(n);
   for (size_t i = 0; i < n; ++i)
@@ -487,8 +472,9 @@ TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
 
 TEST(DacpoPipeline, BlockFlipsAndEdgesAreConsistent)
 {
-  Scene sc;
-  generate(DACPO_SCENE_TWO_ROOMS, 20000, 3, &sc);
+  Scene sc(DACPO_SCENE_TWO_ROOMS, 20000, 3);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 20000u);
   dacpo_params p = defaults();
   p.ipsr_enabled = 0; // VCR weights still get one Poisson mesh per block
   Result r = orientScene(sc, p);
@@ -534,8 +520,9 @@ TEST(DacpoPipeline, BlockFlipsAndEdgesAreConsistent)
 
 TEST(DacpoPipeline, StageTimesAddUp)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   Result r = orientScene(sc, p);
@@ -559,8 +546,9 @@ TEST(DacpoPipeline, StageTimesAddUp)
 
 TEST(DacpoPipeline, SameSeedIsBitIdentical)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 4, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 4);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   dacpo_params p = defaults();
   p.seed = 42;
   auto ctx = makeCtx();
@@ -580,8 +568,9 @@ TEST(DacpoPipeline, SameSeedIsBitIdentical)
 
 TEST(DacpoPipeline, ThreadCountDoesNotChangeResult)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 5, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 5);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   p.num_threads = 1;
@@ -604,8 +593,9 @@ TEST(DacpoPipeline, ThreadCountDoesNotChangeResult)
 
 TEST(DacpoPipeline, CallerSearchMatchesBuiltIn)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 4000, 6, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 4000, 6);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 4000u);
   BruteForce bf{sc.s.xyz, sc.s.n};
   dacpo_search search = {bruteForceKnn, &bf};
   for (int estimate : {0, 1}) {
@@ -633,8 +623,9 @@ TEST(DacpoPipeline, CallerSearchMatchesBuiltIn)
 // estimated normals).
 TEST(DacpoPipeline, EdgeWeightsAndIpsrAllSucceed)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   for (dacpo_edge_weight w :
        {DACPO_WEIGHT_VCR, DACPO_WEIGHT_DIPOLE_BOUNDARY, DACPO_WEIGHT_OVERLAP}) {
     for (int ipsr : {0, 1}) {
@@ -657,8 +648,9 @@ TEST(DacpoPipeline, EdgeWeightsAndIpsrAllSucceed)
 
 TEST(DacpoPipeline, ProgressStagesAreOrdered)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 1, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 1);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   p.num_threads = 2;
@@ -697,8 +689,9 @@ TEST(DacpoPipeline, ProgressStagesAreOrdered)
 
 TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 10000, 7, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 10000, 7);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 10000u);
   const size_t n = sc.s.n;
   // Given axes: ground truth tilted a little, any length, random sign. The
   // output must be the given axis, normalized, only its sign chosen.
@@ -743,8 +736,9 @@ TEST(DacpoPipeline, OutputKeepsTheGivenAxis)
 // wound like the output normals (flipped blocks re-wound), near the samples.
 TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 8000, 3, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 8000, 3);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 8000u);
   dacpo_params p = defaults();
   p.keep_mesh = 1;
   auto ctx = makeCtx();
@@ -803,8 +797,9 @@ TEST(DacpoPipeline, KeptMeshAgreesWithOutputNormals)
 // keep_mesh the blocks have meshes, which once made every measure VCR.
 TEST(DacpoPipeline, KeepingTheMeshKeepsTheEdgeWeightMeasure)
 {
-  Scene sc;
-  generate(DACPO_SCENE_BOX_OPEN, 8000, 3, &sc);
+  Scene sc(DACPO_SCENE_BOX_OPEN, 8000, 3);
+  ASSERT_TRUE(sc.ok);
+  ASSERT_EQ(sc.s.n, 8000u);
   for (dacpo_edge_weight w : {DACPO_WEIGHT_DIPOLE_BOUNDARY, DACPO_WEIGHT_OVERLAP}) {
     std::vector<std::vector<double>> alpha(2);
     for (int keep = 0; keep < 2; ++keep) {
