@@ -100,6 +100,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_layers = 2.0;
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
+  p->dipole_c_thin = 4.0;
 }
 
 static dacpo_status
@@ -229,6 +230,11 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_two_sheet must be finite and >= 0 (got %g)",
                      p->dipole_two_sheet);
+  if (!(p->dipole_c_thin >= 0.0) || !isfinite(p->dipole_c_thin))
+    return bad_field(message,
+                     size,
+                     "dipole_c_thin must be finite and >= 0 (got %g)",
+                     p->dipole_c_thin);
   if (!(p->dipole_layers >= 0.0) || !isfinite(p->dipole_layers))
     return bad_field(message,
                      size,

@@ -28,6 +28,9 @@ typedef struct dacpo_dipole_params {
   double layers;     /* 0 = off; else, in a block seen from one side, parallel
                         pairs offset by more than layers x local spacing get
                         c = 1 (dacpo_params.dipole_layers) */
+  double c_thin;     /* 0 = off; else, in a block with thin two-sided parts
+                        (two_sheet > 0), pairs offset beyond two_sheet x local
+                        noise get this c (dacpo_params.dipole_c_thin) */
   double sides;      /* 0 = off; else weight of the thin-part side cue
                         (dacpo_sheet_side.h; dacpo_params.dipole_sides) */
   uint8_t* thin_out; /* optional output (n entries, may be NULL): 1 where the

@@ -216,6 +216,7 @@ block_dipole_params(const run_state* s, size_t b, uint8_t* thin)
   dp.noise_band = s->p.dipole_noise_band;
   dp.two_sheet = s->p.dipole_two_sheet;
   dp.layers = s->p.dipole_layers;
+  dp.c_thin = s->p.dipole_c_thin;
   dp.restarts = s->p.dipole_restarts;
   dp.restart_vote = s->p.dipole_restart_vote;
   dp.sides = s->p.dipole_sides;

@@ -255,6 +255,13 @@ const OptionSpec kOptions[] = {
      "face opposite ways, 0 = off",
      showNumber<double, &dacpo_params::dipole_two_sheet>,
      setDouble<&dacpo_params::dipole_two_sheet>},
+    {"-c_thin",
+     "X",
+     "thin parts: in blocks with two-sided parts, pairs off each\n"
+     "other's tangent plane beyond the two-sheet noise test use\n"
+     "dipole constant X (paper: 4 for clean data), 0 = off",
+     showNumber<double, &dacpo_params::dipole_c_thin>,
+     setDouble<&dacpo_params::dipole_c_thin>},
     {"-layers",
      "X",
      "layered one-sided surfaces: parallel neighbours off each\n"

@@ -573,6 +573,24 @@ public:
     return params_.dipole_two_sheet;
   }
 
+  /** \brief Dipole constant for geometry in blocks with thin two-sided parts
+   * (default 4, 0 = off): where >= 3 % of a block's points have a second sheet
+   * beneath them, neighbour pairs lying off each other's tangent plane by more
+   * than the two-sheet noise test (setDipoleTwoSheet() x local noise) use this c
+   * in Eq. 1 instead of setDipoleC()'s; blocks seen from one side (single depth
+   * frames) keep setDipoleC(). See dacpo_params.dipole_c_thin. */
+  void
+  setDipoleCThin(double c)
+  {
+    params_.dipole_c_thin = c;
+  }
+  /** \brief See setDipoleCThin(). */
+  double
+  getDipoleCThin() const
+  {
+    return params_.dipole_c_thin;
+  }
+
   /** \brief Layered surfaces seen from one side (default 2, 0 = off; 0.5 for
    * single-view depth data): neighbours with parallel axes more than this many local
    * spacings off each other's tangent plane are layers of one surface (depth
