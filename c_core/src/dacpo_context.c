@@ -420,56 +420,6 @@ dacpo_ctx_edges(const dacpo_ctx* ctx)
 
 /* ---- utilities --------------------------------------------------------- */
 
-static uint64_t
-splitmix64(uint64_t* x)
-{
-  uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-void
-dacpo_rng_seed(dacpo_rng* rng, uint64_t seed, uint64_t stream)
-{
-  uint64_t x = seed ^ (stream * 0xD1B54A32D192ED03ull);
-  for (int i = 0; i < 4; ++i)
-    rng->s[i] = splitmix64(&x);
-}
-
-static uint64_t
-rotl(uint64_t x, int k)
-{
-  return (x << k) | (x >> (64 - k));
-}
-
-uint64_t
-dacpo_rng_next(dacpo_rng* rng)
-{
-  uint64_t* s = rng->s;
-  const uint64_t result = rotl(s[1] * 5, 7) * 9;
-  const uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl(s[3], 45);
-  return result;
-}
-
-double
-dacpo_rng_uniform(dacpo_rng* rng)
-{
-  return (double)(dacpo_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-size_t
-dacpo_rng_below(dacpo_rng* rng, size_t n)
-{
-  return (size_t)(dacpo_rng_uniform(rng) * (double)n) % n;
-}
-
 double
 dacpo_now(void)
 {

@@ -5,6 +5,8 @@
 
 #include <dacpo/dacpo.h>
 
+#include "dacpo_rng.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -38,23 +40,6 @@ dacpo_err_set(dacpo_err* err, dacpo_status code, const char* fmt, ...)
 
 #define DACPO_OOM(err)                                                                 \
   dacpo_err_set((err), DACPO_ERR_OUT_OF_MEMORY, "out of memory in %s", __func__)
-
-/* Small deterministic RNG (splitmix64 seeding + xoshiro256**). Each block gets
- * its own stream from (seed, block id), so results do not depend on threads. */
-typedef struct dacpo_rng {
-  uint64_t s[4];
-} dacpo_rng;
-
-void
-dacpo_rng_seed(dacpo_rng* rng, uint64_t seed, uint64_t stream);
-uint64_t
-dacpo_rng_next(dacpo_rng* rng);
-/* uniform in [0, 1) */
-double
-dacpo_rng_uniform(dacpo_rng* rng);
-/* uniform integer in [0, n), n > 0 */
-size_t
-dacpo_rng_below(dacpo_rng* rng, size_t n);
 
 /* Wall clock in seconds (monotonic). */
 double

@@ -23,6 +23,8 @@
  */
 #include "dacpo_scene.h"
 
+#include "dacpo_rng.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -47,66 +49,17 @@ enum {
 };
 
 /* ------------------------------------------------------------------------- */
-/* RNG: xoshiro256** seeded by splitmix64 (public-domain algorithms).         */
-
-typedef struct scene_rng {
-  uint64_t s[4];
-} scene_rng;
-
-static uint64_t
-splitmix64(uint64_t* x)
-{
-  uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-static void
-rng_init(scene_rng* r, uint64_t seed, uint64_t stream)
-{
-  uint64_t x = seed ^ (stream * 0xD1B54A32D192ED03ull);
-  for (int i = 0; i < 4; ++i)
-    r->s[i] = splitmix64(&x);
-}
-
-static uint64_t
-rotl64(uint64_t x, int k)
-{
-  return (x << k) | (x >> (64 - k));
-}
-
-static uint64_t
-rng_next(scene_rng* r)
-{
-  uint64_t* s = r->s;
-  const uint64_t result = rotl64(s[1] * 5, 7) * 9;
-  const uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl64(s[3], 45);
-  return result;
-}
-
-/* Uniform in [0, 1), 53 random bits. */
-static double
-rng_uniform(scene_rng* r)
-{
-  return (double)(rng_next(r) >> 11) * (1.0 / 9007199254740992.0);
-}
+/* RNG: the core's xoshiro256** (dacpo_rng.h), plus two distributions.        */
 
 /* Standard normal, Marsaglia's polar method (second value discarded to keep the
  * generator stateless beyond the xoshiro state). */
 static double
-rng_gauss(scene_rng* r)
+rng_gauss(dacpo_rng* r)
 {
   double u, v, s;
   do {
-    u = 2.0 * rng_uniform(r) - 1.0;
-    v = 2.0 * rng_uniform(r) - 1.0;
+    u = 2.0 * dacpo_rng_uniform(r) - 1.0;
+    v = 2.0 * dacpo_rng_uniform(r) - 1.0;
     s = u * u + v * v;
   } while (s >= 1.0 || s == 0.0);
   return u * sqrt(-2.0 * log(s) / s);
@@ -114,10 +67,10 @@ rng_gauss(scene_rng* r)
 
 /* Uniform unit vector: z uniform in [-1, 1] and uniform azimuth (Archimedes). */
 static void
-rng_unit_vector(scene_rng* r, double d[3])
+rng_unit_vector(dacpo_rng* r, double d[3])
 {
-  const double z = 2.0 * rng_uniform(r) - 1.0;
-  const double phi = 2.0 * SCENE_PI * rng_uniform(r);
+  const double z = 2.0 * dacpo_rng_uniform(r) - 1.0;
+  const double phi = 2.0 * SCENE_PI * dacpo_rng_uniform(r);
   const double rho = sqrt(fmax(0.0, 1.0 - z * z));
   d[0] = rho * cos(phi);
   d[1] = rho * sin(phi);
@@ -368,7 +321,7 @@ prim_area(const scene_prim* p)
 
 /* One uniform sample on patch p: position and unit normal, in double. */
 static void
-prim_sample(const scene_prim* p, scene_rng* r, double pos[3], double nrm[3])
+prim_sample(const scene_prim* p, dacpo_rng* r, double pos[3], double nrm[3])
 {
   switch (p->type) {
   case PRIM_QUAD: {
@@ -377,8 +330,8 @@ prim_sample(const scene_prim* p, scene_rng* r, double pos[3], double nrm[3])
     /* Rejection from the holes; they cover a small part of every quad, so the
      * expected number of tries stays close to one. */
     do {
-      s = rng_uniform(r);
-      t = rng_uniform(r);
+      s = dacpo_rng_uniform(r);
+      t = dacpo_rng_uniform(r);
       inside = 0;
       for (int i = 0; i < p->nholes && !inside; ++i)
         inside = s >= p->hole[i][0] && s < p->hole[i][1] && t >= p->hole[i][2] &&
@@ -391,8 +344,8 @@ prim_sample(const scene_prim* p, scene_rng* r, double pos[3], double nrm[3])
     return;
   }
   case PRIM_CYLINDER: {
-    const double a = p->a0 + (p->a1 - p->a0) * rng_uniform(r);
-    const double h = p->h * rng_uniform(r);
+    const double a = p->a0 + (p->a1 - p->a0) * dacpo_rng_uniform(r);
+    const double h = p->h * dacpo_rng_uniform(r);
     const double ca = cos(a), sa = sin(a);
     for (int k = 0; k < 3; ++k) {
       const double radial = ca * p->u[k] + sa * p->v[k];
@@ -403,9 +356,9 @@ prim_sample(const scene_prim* p, scene_rng* r, double pos[3], double nrm[3])
   }
   case PRIM_ANNULUS: {
     /* Radius by inverse CDF of the area measure rho d rho. */
-    const double a = 2.0 * SCENE_PI * rng_uniform(r);
+    const double a = 2.0 * SCENE_PI * dacpo_rng_uniform(r);
     const double rho =
-        sqrt(p->r0 * p->r0 + rng_uniform(r) * (p->r1 * p->r1 - p->r0 * p->r0));
+        sqrt(p->r0 * p->r0 + dacpo_rng_uniform(r) * (p->r1 * p->r1 - p->r0 * p->r0));
     const double ca = cos(a), sa = sin(a);
     for (int k = 0; k < 3; ++k) {
       pos[k] = p->c[k] + rho * (ca * p->u[k] + sa * p->v[k]);
@@ -803,11 +756,11 @@ apportion(const double* area, size_t count, size_t n, size_t* out, quota_item* i
 static void
 downsample(dacpo_scene* s, size_t k, uint64_t seed)
 {
-  scene_rng r;
+  dacpo_rng r;
   size_t kept = 0;
-  rng_init(&r, seed, STREAM_DOWNSAMPLE);
+  dacpo_rng_seed(&r, seed, STREAM_DOWNSAMPLE);
   for (size_t i = 0; i < s->n && kept < k; ++i) {
-    if ((double)(s->n - i) * rng_uniform(&r) < (double)(k - kept)) {
+    if ((double)(s->n - i) * dacpo_rng_uniform(&r) < (double)(k - kept)) {
       memmove(s->xyz + 3 * kept, s->xyz + 3 * i, 3 * sizeof(float));
       memmove(s->normals + 3 * kept, s->normals + 3 * i, 3 * sizeof(float));
       s->part[kept] = s->part[i];
@@ -836,8 +789,8 @@ downsample(dacpo_scene* s, size_t k, uint64_t seed)
 static void
 add_noise(dacpo_scene* s, double sigma, uint64_t seed)
 {
-  scene_rng r;
-  rng_init(&r, seed, STREAM_NOISE);
+  dacpo_rng r;
+  dacpo_rng_seed(&r, seed, STREAM_NOISE);
   for (size_t i = 0; i < s->n; ++i) {
     double d[3];
     const double g = sigma * rng_gauss(&r);
@@ -889,9 +842,9 @@ sample_patches(const scene_builder* b,
                uint64_t seed,
                dacpo_scene* s)
 {
-  scene_rng r;
+  dacpo_rng r;
   size_t next = 0;
-  rng_init(&r, seed, STREAM_GEOMETRY);
+  dacpo_rng_seed(&r, seed, STREAM_GEOMETRY);
   for (size_t i = 0; i < b->count; ++i) {
     for (size_t j = 0; j < counts[i]; ++j, ++next) {
       double pos[3] = {0.0, 0.0, 0.0}, nrm[3] = {0.0, 0.0, 1.0}, len;
@@ -999,7 +952,7 @@ dacpo_scramble_signs(const float* normals_in,
                      uint64_t seed,
                      double fraction)
 {
-  scene_rng r;
+  dacpo_rng r;
   size_t k, flipped = 0;
   if (!normals_in || !normals_out || n == 0)
     return 0;
@@ -1010,10 +963,10 @@ dacpo_scramble_signs(const float* normals_in,
   k = (size_t)floor(fraction * (double)n + 0.5);
   if (k > n)
     k = n;
-  rng_init(&r, seed, STREAM_SCRAMBLE);
+  dacpo_rng_seed(&r, seed, STREAM_SCRAMBLE);
   for (size_t i = 0; i < n; ++i) {
     /* Selection sampling: exactly k flips, uniformly placed. */
-    const int flip = (double)(n - i) * rng_uniform(&r) < (double)(k - flipped);
+    const int flip = (double)(n - i) * dacpo_rng_uniform(&r) < (double)(k - flipped);
     const float sgn = flip ? -1.0f : 1.0f;
     flipped += (size_t)flip;
     for (int c = 0; c < 3; ++c)
@@ -1157,16 +1110,16 @@ dacpo_scene_parallel_sheets(double size,
       snprintf(err, errlen, "parallel sheets: out of memory");
     return -1;
   }
-  scene_rng r;
-  rng_init(&r, seed, 17);
+  dacpo_rng r;
+  dacpo_rng_seed(&r, seed, 17);
   size_t k = 0;
   for (int sheet = 0; sheet < 2; ++sheet)
     for (size_t a = 0; a < m; ++a)
       for (size_t b = 0; b < m; ++b, ++k) {
         /* jittered grid, so the two sheets' points do not sit exactly above
          * each other; the lower sheet faces -z, the upper +z */
-        double p[3] = {((double)a + 0.5 * (rng_uniform(&r) - 0.5)) * spacing,
-                       ((double)b + 0.5 * (rng_uniform(&r) - 0.5)) * spacing,
+        double p[3] = {((double)a + 0.5 * (dacpo_rng_uniform(&r) - 0.5)) * spacing,
+                       ((double)b + 0.5 * (dacpo_rng_uniform(&r) - 0.5)) * spacing,
                        sheet ? gap : 0.0};
         if (sigma > 0.0) {
           double d[3];
