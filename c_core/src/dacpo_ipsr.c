@@ -55,8 +55,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SPACING_K 8
-
 void
 dacpo_ipsr_params_default(dacpo_ipsr_params* p)
 {
@@ -227,17 +225,11 @@ static dacpo_status
 estimate_spacing(
     ipsr_work* w, const double* xyz, size_t n, double* spacing, dacpo_err* err)
 {
-  int32_t idx[SPACING_K + 1];
-  double d2[SPACING_K + 1];
-  size_t k = n < SPACING_K + 1 ? n : SPACING_K + 1;
   double* tmp = (double*)dacpo_malloc_array(n, sizeof(double));
   if (!tmp)
     return DACPO_OOM(err);
   for (size_t i = 0; i < n; ++i) {
-    size_t got = dacpo_kdtree_knn(w->tree, xyz + 3 * i, k, idx, d2);
-    double r2 = got > 0 ? d2[got - 1] : 0.0;
-    /* got - 1 neighbours besides the query itself within r */
-    w->area[i] = got > 1 ? 3.14159265358979323846 * r2 / (double)(got - 1) : 0.0;
+    w->area[i] = dacpo_kdtree_sample_area(w->tree, xyz + 3 * i);
     tmp[i] = w->area[i];
   }
   double med = dacpo_select_kth(tmp, n, n / 2);

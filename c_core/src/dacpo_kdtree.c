@@ -374,6 +374,15 @@ dacpo_kdtree_order(const dacpo_kdtree* tree)
   return tree && tree->n > 0 ? tree->ids : NULL;
 }
 
+double
+dacpo_kdtree_sample_area(const dacpo_kdtree* tree, const double q[3])
+{
+  int32_t idx[DACPO_SAMPLE_AREA_K];
+  double d2[DACPO_SAMPLE_AREA_K];
+  const size_t got = dacpo_kdtree_knn(tree, q, DACPO_SAMPLE_AREA_K, idx, d2);
+  return got > 1 ? 3.14159265358979323846 * d2[got - 1] / (double)(got - 1) : 0.0;
+}
+
 size_t
 dacpo_kdtree_knn(const dacpo_kdtree* tree,
                  const double q[3],

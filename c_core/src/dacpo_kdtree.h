@@ -31,4 +31,14 @@ dacpo_kdtree_knn(const dacpo_kdtree* tree,
 const int32_t*
 dacpo_kdtree_order(const dacpo_kdtree* tree);
 
+/* Nearest points (q's own point among them) behind one sample's area. */
+#define DACPO_SAMPLE_AREA_K 9
+
+/* The surface area one sample covers: pi r^2 / (m - 1), r the distance to the
+ * farthest of the up to DACPO_SAMPLE_AREA_K nearest points of q and m how many
+ * were found; 0 when m < 2. sqrt of the median over a cloud is its spacing
+ * (stage 3 per block, the scene mesh over the scene). */
+double
+dacpo_kdtree_sample_area(const dacpo_kdtree* tree, const double q[3]);
+
 #endif

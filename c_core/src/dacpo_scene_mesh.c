@@ -42,9 +42,6 @@
 #define NODE_RADIUS 3.0
 /* Marching-cubes tile edge in cubes (a tile is (TILE + 1)^3 nodes, 144 KB). */
 #define TILE 32
-/* Neighbours for the spacing estimate (sqrt of the area pi r_k^2 / k per sample,
- * as stage 3 measures it). */
-#define SPACING_K 8
 /* Samples of the spacing estimate. */
 #define SPACING_SAMPLES 20000
 /* Lattice cells per axis at most: node keys (and edge keys, 2 bits more) fit
@@ -175,13 +172,11 @@ scene_spacing(const dacpo_kdtree* tree,
   double* area = dacpo_malloc_array(m, sizeof(double));
   if (!area)
     return DACPO_OOM(err);
-  int32_t idx[SPACING_K + 1];
-  double d2[SPACING_K + 1];
   size_t used = 0;
   for (size_t i = 0; i < n; i += step) {
-    size_t got = dacpo_kdtree_knn(tree, xyz + 3 * i, SPACING_K + 1, idx, d2);
-    if (got > 1 && d2[got - 1] > 0.0)
-      area[used++] = 3.14159265358979323846 * d2[got - 1] / (double)(got - 1);
+    const double a = dacpo_kdtree_sample_area(tree, xyz + 3 * i);
+    if (a > 0.0)
+      area[used++] = a;
   }
   *spacing = used ? sqrt(dacpo_select_kth(area, used, used / 2)) : 0.0;
   free(area);

@@ -234,3 +234,33 @@ TEST(DacpoKdtree, ConcurrentQueriesAgree)
   EXPECT_EQ(a, b);
   dacpo_kdtree_free(t);
 }
+
+// The area one sample covers, on a square grid of spacing h: the 9 nearest of
+// an interior point are itself, 4 at h and 4 at h sqrt(2), so the area is
+// pi (2 h^2) / 8 = pi h^2 / 4. With 2 points: pi d^2 / 1; one point: 0.
+TEST(DacpoKdtree, SampleAreaOnAGridIsPiSpacingSquaredOverFour)
+{
+  const double h = 0.03;
+  std::vector<double> xyz;
+  for (int i = 0; i < 11; ++i)
+    for (int j = 0; j < 11; ++j) {
+      xyz.push_back(i * h);
+      xyz.push_back(j * h);
+      xyz.push_back(0.5);
+    }
+  dacpo_kdtree* tree = nullptr;
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_kdtree_build(xyz.data(), xyz.size() / 3, &tree, &err), DACPO_OK);
+  const double* centre = xyz.data() + 3 * (5 * 11 + 5);
+  EXPECT_NEAR(dacpo_kdtree_sample_area(tree, centre), M_PI * h * h / 4.0, 1e-15);
+  dacpo_kdtree_free(tree);
+
+  const double two[6] = {0, 0, 0, 0.2, 0, 0};
+  ASSERT_EQ(dacpo_kdtree_build(two, 2, &tree, &err), DACPO_OK);
+  EXPECT_NEAR(dacpo_kdtree_sample_area(tree, two), M_PI * 0.04, 1e-15);
+  dacpo_kdtree_free(tree);
+
+  ASSERT_EQ(dacpo_kdtree_build(two, 1, &tree, &err), DACPO_OK);
+  EXPECT_EQ(dacpo_kdtree_sample_area(tree, two), 0.0);
+  dacpo_kdtree_free(tree);
+}
