@@ -45,6 +45,8 @@
  *   is freed on every path; `component` changes only on success. */
 #include "dacpo_bridge.h"
 
+#include "dacpo_select.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,20 +66,12 @@ typedef struct br_node {
   int32_t label;       /* component of all points below, or -1 (mixed) */
 } br_node;
 
-/* A point in tree order: coordinates and index together, so the build's
- * selections and box scans and the searches read memory sequentially. */
-typedef struct br_pt {
-  double x[3];
-  int32_t id;
-  int32_t pad;
-} br_pt;
-
 typedef struct br_tree {
   size_t num_nodes;
   size_t num_leaves;
-  br_pt* pts;      /* n points in tree order */
-  br_node* nodes;  /* preorder: parent before children */
-  int32_t* leaves; /* node ids of the leaves, in tree order */
+  dacpo_tree_point* pts; /* n points in tree order */
+  br_node* nodes;        /* preorder: parent before children */
+  int32_t* leaves;       /* node ids of the leaves, in tree order */
 } br_tree;
 
 /* Best cross pair of a component: a in the component, b outside it. */
@@ -105,50 +99,8 @@ typedef struct br_leafkey {
 
 /* ---- kd-tree -------------------------------------------------------------- */
 
-static int
-br_less(const br_pt* a, const br_pt* b, int dim)
-{
-  return a->x[dim] < b->x[dim] || (a->x[dim] == b->x[dim] && a->id < b->id);
-}
-
-static void
-br_swap(br_pt* a, br_pt* b)
-{
-  br_pt t = *a;
-  *a = *b;
-  *b = t;
-}
-
-/* Quickselect on (coordinate, index): keys are distinct, so a plain partition
- * around a median-of-three pivot is expected linear. */
-static void
-br_select(br_pt* p, size_t lo, size_t hi, size_t k, int dim)
-{
-  while (hi - lo > 1) {
-    size_t mid = lo + (hi - lo) / 2, last = hi - 1, piv_pos;
-    const br_pt *a = &p[lo], *b = &p[mid], *c = &p[last];
-    if (br_less(a, b, dim))
-      piv_pos = br_less(b, c, dim) ? mid : (br_less(a, c, dim) ? last : lo);
-    else
-      piv_pos = br_less(a, c, dim) ? lo : (br_less(b, c, dim) ? last : mid);
-    br_swap(&p[piv_pos], &p[last]);
-    const br_pt* piv = &p[last];
-    size_t store = lo;
-    for (size_t i = lo; i < last; ++i)
-      if (br_less(&p[i], piv, dim))
-        br_swap(&p[i], &p[store++]);
-    br_swap(&p[store], &p[last]);
-    if (k == store)
-      return;
-    if (k < store)
-      hi = store;
-    else
-      lo = store + 1;
-  }
-}
-
 static int32_t
-br_build_node(br_tree* t, size_t begin, size_t end)
+br_build_node(br_tree* t, size_t begin, size_t end, dacpo_rng* rng)
 {
   int32_t id = (int32_t)t->num_nodes++;
   br_node* nd = &t->nodes[id];
@@ -178,9 +130,9 @@ br_build_node(br_tree* t, size_t begin, size_t end)
     if (nd->hi[d] - nd->lo[d] > nd->hi[dim] - nd->lo[dim])
       dim = d;
   size_t mid = begin + (end - begin) / 2;
-  br_select(t->pts, begin, end, mid, dim);
-  int32_t left = br_build_node(t, begin, mid);
-  int32_t right = br_build_node(t, mid, end);
+  dacpo_select_points(t->pts, begin, end, mid, dim, rng);
+  int32_t left = br_build_node(t, begin, mid, rng);
+  int32_t right = br_build_node(t, mid, end, rng);
   t->nodes[id].left = left;
   t->nodes[id].right = right;
   return id;
@@ -201,19 +153,17 @@ br_tree_build(br_tree* t, const double* xyz, size_t n, dacpo_err* err)
   memset(t, 0, sizeof(*t));
   /* Splits of > 16 points give halves of >= 8, so at most n / 8 + 1 leaves. */
   size_t max_leaves = n / 8 + 1;
-  t->pts = dacpo_malloc_array(n, sizeof(br_pt));
+  t->pts = dacpo_malloc_array(n, sizeof(dacpo_tree_point));
   t->nodes = dacpo_malloc_array(2 * max_leaves, sizeof(br_node));
   t->leaves = dacpo_malloc_array(max_leaves, sizeof(int32_t));
   if (!t->pts || !t->nodes || !t->leaves) {
     br_tree_free(t);
     return DACPO_OOM(err);
   }
-  for (size_t i = 0; i < n; ++i) {
-    memcpy(t->pts[i].x, xyz + 3 * i, 3 * sizeof(double));
-    t->pts[i].id = (int32_t)i;
-    t->pts[i].pad = 0;
-  }
-  br_build_node(t, 0, n);
+  dacpo_tree_points_fill(t->pts, xyz, NULL, n);
+  dacpo_rng rng; /* pivots only; fixed seed */
+  dacpo_rng_seed(&rng, 0x9E3779B97F4A7C15ULL, 2);
+  br_build_node(t, 0, n, &rng);
   return DACPO_OK;
 }
 

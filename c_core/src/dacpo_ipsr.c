@@ -75,7 +75,6 @@ dacpo_ipsr_params_default(dacpo_ipsr_params* p)
    * accurate as 1e-3 and 1.5x faster per block */
   p->tolerance = 3e-2;
   p->max_cg_iterations = 30;
-  p->trim_interior = 0;
   p->band = 2;
   p->fixed = NULL;
 }
@@ -256,7 +255,7 @@ estimate_spacing(
 }
 
 /* Marks the faces to trim: far from the data and joined to the mesh rim by
- * far faces (or every far face with trim_interior). */
+ * far faces (or every far face with experiment.trim_interior). */
 static void
 trim_faces(ipsr_work* w, const dacpo_mesh* m, double far2, int interior)
 {
@@ -590,7 +589,7 @@ ipsr_surface(ipsr_work* w,
     return DACPO_OOM(err);
   query_faces(w, *mesh, k);
   if (trimming)
-    trim_faces(w, *mesh, far2, params->trim_interior);
+    trim_faces(w, *mesh, far2, params->experiment.trim_interior);
   else
     memset(w->removed, 0, (*mesh)->num_triangles);
   return DACPO_OK;
@@ -753,7 +752,7 @@ dacpo_ipsr_block(const double* xyz,
     goto done;
   if (mesh_out && run.mesh && run.mesh->num_triangles > 0) {
     if (!run.mesh_trimmed)
-      trim_faces(&w, run.mesh, run.far2, params->trim_interior);
+      trim_faces(&w, run.mesh, run.far2, params->experiment.trim_interior);
     status = build_output(&w, run.mesh, nrm, n_own, run.k, mesh_out, err);
     if (status != DACPO_OK)
       goto done;

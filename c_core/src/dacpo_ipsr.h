@@ -7,6 +7,13 @@
 
 #include "dacpo_internal.h"
 
+/* A trimming variant kept only for a comparison test (it also cuts the film
+ * across holes inside the data, which the default keeps); not reachable from
+ * dacpo_params or the tools. 0 by default. */
+typedef struct dacpo_ipsr_experiment {
+  int trim_interior; /* 1: trim every far face, also inside the data */
+} dacpo_ipsr_experiment;
+
 typedef struct dacpo_ipsr_params {
   size_t max_iterations; /* 20 */
   double convergence;    /* 0.1: mean of the largest max(ceil(n/1000),10) |dn| */
@@ -23,12 +30,12 @@ typedef struct dacpo_ipsr_params {
   double tolerance; /* Poisson solve: relative residual (3e-2; the warm-started
                        loop refines chi across iterations) */
   size_t max_cg_iterations; /* Poisson solve: multigrid-CG steps (30) */
-  int trim_interior;        /* 1: trim every far face, also inside the data (0) */
   size_t band;              /* Poisson domain: cells within this many cells of the
                                samples (>= 2); 0 = the whole padded box (2) */
   const uint8_t* fixed;     /* NULL, or n flags: samples whose normals the
                                iterations leave as given (parts thinner than
                                the grid, see dacpo_pipeline.c) (NULL) */
+  dacpo_ipsr_experiment experiment; /* off (above) */
 } dacpo_ipsr_params;
 
 void

@@ -6,7 +6,8 @@
  * Input:  n points (3n doubles, copied). Output: a read-only tree.
  * Layout: the points are permuted into tree order (leaves are contiguous runs)
  * and the nodes live in one array; the children of a node are adjacent.
- * Build:  median split by COUNT (quickselect on (coordinate, index)) along the
+ * Build:  median split by COUNT (quickselect on (coordinate, index),
+ *         dacpo_select.h) along the
  *         widest axis of the node's bounding box, until a node holds at most
  *         KD_LEAF points. Splitting by count keeps the depth at about log2(n/8)
  *         even when all points coincide. O(n log n) time, no extra memory
@@ -21,6 +22,8 @@
  *   allocation (OUT_OF_MEMORY). A non-finite query gets 0 neighbours.
  * Queries never allocate and are safe from several threads at once. */
 #include "dacpo_kdtree.h"
+
+#include "dacpo_select.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -45,8 +48,7 @@ typedef struct kd_node {
 
 struct dacpo_kdtree {
   size_t n;
-  double* pts;  /* 3n, tree order */
-  int32_t* ids; /* n, original index of each tree-order point */
+  dacpo_tree_point* pts; /* n, tree order, with their original index */
   kd_node* nodes;
   size_t num_nodes;
 };
@@ -54,90 +56,13 @@ struct dacpo_kdtree {
 /* ---- build ------------------------------------------------------------- */
 
 typedef struct kd_build {
-  double* pts;
-  int32_t* ids;
+  dacpo_tree_point* pts; /* permuted into tree order by the build */
   kd_node* nodes;
   size_t num_nodes;
   size_t cap_nodes;
-  uint64_t rng; /* pivot choice only; fixed seed keeps builds identical */
+  dacpo_rng rng; /* pivot choice only; fixed seed keeps builds identical */
   size_t max_depth;
 } kd_build;
-
-static void
-kd_swap(double* pts, int32_t* ids, size_t a, size_t b)
-{
-  double t0 = pts[3 * a], t1 = pts[3 * a + 1], t2 = pts[3 * a + 2];
-  pts[3 * a] = pts[3 * b];
-  pts[3 * a + 1] = pts[3 * b + 1];
-  pts[3 * a + 2] = pts[3 * b + 2];
-  pts[3 * b] = t0;
-  pts[3 * b + 1] = t1;
-  pts[3 * b + 2] = t2;
-  int32_t ti = ids[a];
-  ids[a] = ids[b];
-  ids[b] = ti;
-}
-
-/* (coordinate, original index) order: all keys distinct, so quickselect needs
- * no special care for repeated coordinates and the split is by count. */
-static int
-kd_less(const double* pts, const int32_t* ids, int dim, size_t a, size_t b)
-{
-  double va = pts[3 * a + dim], vb = pts[3 * b + dim];
-  return va < vb || (va == vb && ids[a] < ids[b]);
-}
-
-static uint64_t
-kd_rand(uint64_t* s)
-{
-  /* xorshift64*: only spreads pivots so sorted inputs stay O(n) expected. */
-  uint64_t x = *s;
-  x ^= x >> 12;
-  x ^= x << 25;
-  x ^= x >> 27;
-  *s = x;
-  return x * 2685821657736338717ULL;
-}
-
-/* Puts the element of rank `nth` (by kd_less) at position nth, smaller ones
- * before it and larger ones after it, within [lo, hi). */
-static void
-kd_select(kd_build* b, int dim, size_t lo, size_t hi, size_t nth)
-{
-  double* pts = b->pts;
-  int32_t* ids = b->ids;
-  while (hi - lo > 2) {
-    /* median of three random positions as the pivot */
-    size_t m = hi - lo;
-    size_t a = lo + (size_t)(kd_rand(&b->rng) % m);
-    size_t c = lo + (size_t)(kd_rand(&b->rng) % m);
-    size_t d = lo + (size_t)(kd_rand(&b->rng) % m);
-    size_t piv;
-    if (kd_less(pts, ids, dim, a, c))
-      piv = kd_less(pts, ids, dim, c, d) ? c : (kd_less(pts, ids, dim, a, d) ? d : a);
-    else
-      piv = kd_less(pts, ids, dim, a, d) ? a : (kd_less(pts, ids, dim, c, d) ? d : c);
-    /* Lomuto partition with the pivot parked at hi - 1 */
-    kd_swap(pts, ids, piv, hi - 1);
-    size_t store = lo;
-    for (size_t i = lo; i < hi - 1; ++i) {
-      if (kd_less(pts, ids, dim, i, hi - 1)) {
-        if (i != store)
-          kd_swap(pts, ids, i, store);
-        ++store;
-      }
-    }
-    kd_swap(pts, ids, store, hi - 1);
-    if (store == nth)
-      return;
-    if (nth < store)
-      hi = store;
-    else
-      lo = store + 1;
-  }
-  if (hi - lo == 2 && kd_less(pts, ids, dim, lo + 1, lo))
-    kd_swap(pts, ids, lo, lo + 1);
-}
 
 /* Recursion depth is the tree depth, about log2(n / KD_LEAF) <= 28. */
 static void
@@ -155,13 +80,13 @@ kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
   if (end - begin <= KD_LEAF || b->num_nodes + 2 > b->cap_nodes)
     return;
 
-  const double* p = b->pts;
+  const dacpo_tree_point* p = b->pts;
   double lo[3], hi[3];
   for (int d = 0; d < 3; ++d)
-    lo[d] = hi[d] = p[3 * begin + d];
+    lo[d] = hi[d] = p[begin].x[d];
   for (size_t i = begin + 1; i < end; ++i) {
     for (int d = 0; d < 3; ++d) {
-      double v = p[3 * i + d];
+      double v = p[i].x[d];
       if (v < lo[d])
         lo[d] = v;
       if (v > hi[d])
@@ -174,18 +99,18 @@ kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
       dim = d;
 
   size_t mid = begin + (end - begin) / 2;
-  kd_select(b, dim, begin, end, mid);
-  double low_max = p[3 * begin + dim];
+  dacpo_select_points(b->pts, begin, end, mid, dim, &b->rng);
+  double low_max = p[begin].x[dim];
   for (size_t i = begin + 1; i < mid; ++i)
-    if (p[3 * i + dim] > low_max)
-      low_max = p[3 * i + dim];
+    if (p[i].x[dim] > low_max)
+      low_max = p[i].x[dim];
 
   size_t child = b->num_nodes;
   b->num_nodes += 2;
   nd->child = (int32_t)child;
   nd->dim = dim;
   nd->low_max = low_max;
-  nd->high_min = p[3 * mid + dim];
+  nd->high_min = p[mid].x[dim];
   kd_build_node(b, child, begin, mid, depth + 1);
   kd_build_node(b, child + 1, mid, end, depth + 1);
 }
@@ -217,20 +142,17 @@ dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* e
    * (a node with m > KD_LEAF splits into floor(m/2) and ceil(m/2)), so there
    * are at most 2n/KD_LEAF leaves and twice that many nodes. */
   size_t cap = 2 * (n / (KD_LEAF / 2)) + 3;
-  t->pts = dacpo_malloc_array(n, 3 * sizeof(double));
-  t->ids = dacpo_malloc_array(n, sizeof(int32_t));
+  t->pts = dacpo_malloc_array(n, sizeof(dacpo_tree_point));
   t->nodes = dacpo_malloc_array(cap, sizeof(kd_node));
-  if (!t->pts || !t->ids || !t->nodes) {
+  if (!t->pts || !t->nodes) {
     dacpo_kdtree_free(t);
     return DACPO_OOM(err);
   }
-  if (n > 0)
-    memcpy(t->pts, xyz, n * 3 * sizeof(double));
-  for (size_t i = 0; i < n; ++i)
-    t->ids[i] = (int32_t)i;
+  dacpo_tree_points_fill(t->pts, xyz, NULL, n);
 
   if (n > 0) {
-    kd_build b = {t->pts, t->ids, t->nodes, 1, cap, 0x9E3779B97F4A7C15ULL, 0};
+    kd_build b = {t->pts, t->nodes, 1, cap, {{0}}, 0};
+    dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 0);
     kd_build_node(&b, 0, 0, n, 0);
     t->num_nodes = b.num_nodes;
     if (b.max_depth >= KD_MAX_DEPTH) {
@@ -252,7 +174,6 @@ dacpo_kdtree_free(dacpo_kdtree* tree)
   if (!tree)
     return;
   free(tree->pts);
-  free(tree->ids);
   free(tree->nodes);
   free(tree);
 }
@@ -338,15 +259,14 @@ kd_search(const dacpo_kdtree* t, const double q[3], kd_result* r)
         pd->off[dim] = far_off;
       continue;
     }
-    const double* p = t->pts + 3 * (size_t)nd->begin;
-    const int32_t* ids = t->ids + nd->begin;
+    const dacpo_tree_point* p = t->pts + nd->begin;
     uint32_t m = nd->end - nd->begin;
     double worst = r->d[r->k - 1];
-    for (uint32_t i = 0; i < m; ++i, p += 3) {
-      double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+    for (uint32_t i = 0; i < m; ++i, ++p) {
+      double dx = q0 - p->x[0], dy = q1 - p->x[1], dz = q2 - p->x[2];
       double d = dx * dx + dy * dy + dz * dz;
       if (d <= worst) {
-        kd_push(r, d, ids[i]);
+        kd_push(r, d, p->id);
         worst = r->d[r->k - 1];
       }
     }
@@ -368,10 +288,10 @@ kd_search(const dacpo_kdtree* t, const double q[3], kd_result* r)
   }
 }
 
-const int32_t*
-dacpo_kdtree_order(const dacpo_kdtree* tree)
+int32_t
+dacpo_kdtree_order_at(const dacpo_kdtree* tree, size_t pos)
 {
-  return tree && tree->n > 0 ? tree->ids : NULL;
+  return tree->pts[pos].id;
 }
 
 double

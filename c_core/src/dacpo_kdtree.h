@@ -25,11 +25,12 @@ dacpo_kdtree_knn(const dacpo_kdtree* tree,
                  int32_t* idx,
                  double* sq_dist);
 
-/* The n point indices in tree order (leaf by leaf), or NULL when n == 0.
- * Consecutive entries are close in space: querying in this order keeps the
- * tree's nodes and points in cache (about 1.7x faster than a random order). */
-const int32_t*
-dacpo_kdtree_order(const dacpo_kdtree* tree);
+/* The index of the point at tree position pos (0 <= pos < n): positions run
+ * leaf by leaf, so consecutive ones are close in space. Querying in this order
+ * keeps the tree's nodes and points in cache (about 1.7x faster than a random
+ * order). */
+int32_t
+dacpo_kdtree_order_at(const dacpo_kdtree* tree, size_t pos);
 
 /* Nearest points (q's own point among them) behind one sample's area. */
 #define DACPO_SAMPLE_AREA_K 9

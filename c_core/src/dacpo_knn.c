@@ -90,9 +90,8 @@ knn_builtin_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
     return DACPO_OOM(err);
   }
   /* Tasks walk the tree order: neighbouring queries share cached nodes. */
-  const int32_t* order = dacpo_kdtree_order(job->tree);
   for (size_t pos = begin; pos < end; ++pos) {
-    size_t i = (size_t)order[pos];
+    size_t i = (size_t)dacpo_kdtree_order_at(job->tree, pos);
     size_t got = dacpo_kdtree_knn(job->tree, job->cloud->xyz + 3 * i, k + 1, idx, d);
     /* Points are distinct, so self is the only point at distance 0 and comes
      * first; drop it by index all the same. */

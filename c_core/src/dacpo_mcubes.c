@@ -439,26 +439,3 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
   }
   return DACPO_OK;
 }
-
-dacpo_status
-dacpo_mcubes_run(const dacpo_grid* grid,
-                 const float* values,
-                 const uint8_t* domain,
-                 double iso,
-                 dacpo_mesh* out,
-                 dacpo_err* err)
-{
-  DACPO_CHECK(err, out, DACPO_ERR_INVALID_ARGUMENT, "mcubes: out is NULL");
-  memset(out, 0, sizeof(*out));
-  dacpo_mcubes* mc = NULL;
-  DACPO_TRY(dacpo_mcubes_create(&mc, err));
-  const dacpo_mesh* m = NULL;
-  dacpo_status st = dacpo_mcubes_extract(mc, grid, values, domain, iso, &m, err);
-  if (st == DACPO_OK) {
-    /* hand the buffers over */
-    *out = mc->mesh;
-    memset(&mc->mesh, 0, sizeof(mc->mesh));
-  }
-  dacpo_mcubes_free(mc);
-  return st;
-}

@@ -42,13 +42,4 @@ dacpo_mcubes_extract(dacpo_mcubes* mc,
 size_t
 dacpo_mcubes_bytes(const dacpo_mcubes* mc);
 
-/* One-shot: extracts into a new mesh the caller frees with dacpo_mesh_free. */
-dacpo_status
-dacpo_mcubes_run(const dacpo_grid* grid,
-                 const float* values,
-                 const uint8_t* domain,
-                 double iso,
-                 dacpo_mesh* out,
-                 dacpo_err* err);
-
 #endif /* DACPO_MCUBES_H */

@@ -33,6 +33,8 @@
  */
 #include "dacpo_segment.h"
 
+#include "dacpo_select.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -115,54 +117,11 @@ seg_check_adjacency(const dacpo_adjacency* adj, size_t n, dacpo_err* err)
  * ------------------------------------------------------------------------- */
 
 typedef struct seg_splitter {
-  const double* xyz;
-  int32_t* idx;   /* working permutation of the component's points */
-  int32_t* seeds; /* output, in recursion (left first) order */
+  dacpo_tree_point* pts; /* the points grouped by component, permuted by the split */
+  int32_t* seeds;        /* output, in recursion (left first) order */
   size_t num_seeds;
   dacpo_rng rng; /* quickselect pivots only; fixed seed, so deterministic */
 } seg_splitter;
-
-/* Strict order on (coordinate, index): all keys distinct, so quickselect never
- * degrades on ties (grids have many equal coordinates). */
-static int
-seg_less(const double* xyz, int axis, int32_t a, int32_t b)
-{
-  double xa = xyz[3 * (size_t)a + (size_t)axis];
-  double xb = xyz[3 * (size_t)b + (size_t)axis];
-  return xa < xb || (xa == xb && a < b);
-}
-
-/* Rearranges idx[lo, hi) so that idx[lo, kth) are the kth - lo smallest keys.
- * Random pivot: expected O(hi - lo). */
-static void
-seg_select(seg_splitter* s, size_t lo, size_t hi, size_t kth, int axis)
-{
-  int32_t* idx = s->idx;
-  while (hi - lo > 1) {
-    size_t p = lo + dacpo_rng_below(&s->rng, hi - lo);
-    int32_t t = idx[p];
-    idx[p] = idx[hi - 1];
-    idx[hi - 1] = t;
-    int32_t pivot = idx[hi - 1];
-    size_t store = lo;
-    for (size_t i = lo; i + 1 < hi; ++i) {
-      if (seg_less(s->xyz, axis, idx[i], pivot)) {
-        t = idx[i];
-        idx[i] = idx[store];
-        idx[store] = t;
-        ++store;
-      }
-    }
-    idx[hi - 1] = idx[store];
-    idx[store] = pivot;
-    if (store == kth)
-      return;
-    if (kth < store)
-      hi = store;
-    else
-      lo = store + 1;
-  }
-}
 
 /* The seed of a subset: its point nearest the centroid (ties: lower index), a
  * point well inside the subset so the BFS fronts start evenly spread. */
@@ -172,24 +131,24 @@ seg_seed(const seg_splitter* s, size_t lo, size_t hi)
   double c[3] = {0.0, 0.0, 0.0};
   for (size_t i = lo; i < hi; ++i)
     for (int a = 0; a < 3; ++a)
-      c[a] += s->xyz[3 * (size_t)s->idx[i] + (size_t)a];
+      c[a] += s->pts[i].x[a];
   for (int a = 0; a < 3; ++a)
     c[a] /= (double)(hi - lo);
   int32_t best = -1;
   double best_d = INFINITY;
   for (size_t i = lo; i < hi; ++i) {
-    const double* p = s->xyz + 3 * (size_t)s->idx[i];
+    const double* p = s->pts[i].x;
     double d = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
                (p[2] - c[2]) * (p[2] - c[2]);
-    if (best < 0 || d < best_d || (d == best_d && s->idx[i] < best)) {
-      best = s->idx[i];
+    if (best < 0 || d < best_d || (d == best_d && s->pts[i].id < best)) {
+      best = s->pts[i].id;
       best_d = d;
     }
   }
   return best;
 }
 
-/* Splits idx[lo, hi) into m subsets of nearly equal count and appends one seed
+/* Splits pts[lo, hi) into m subsets of nearly equal count and appends one seed
  * per subset. Requires hi - lo >= m >= 1. Recursion depth is log2(m). */
 static void
 seg_split(seg_splitter* s, size_t lo, size_t hi, size_t m)
@@ -201,7 +160,7 @@ seg_split(seg_splitter* s, size_t lo, size_t hi, size_t m)
   double mn[3] = {INFINITY, INFINITY, INFINITY};
   double mx[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = lo; i < hi; ++i) {
-    const double* p = s->xyz + 3 * (size_t)s->idx[i];
+    const double* p = s->pts[i].x;
     for (int a = 0; a < 3; ++a) {
       if (p[a] < mn[a])
         mn[a] = p[a];
@@ -221,13 +180,13 @@ seg_split(seg_splitter* s, size_t lo, size_t hi, size_t m)
     k = m1;
   if (k > cnt - m2)
     k = cnt - m2;
-  seg_select(s, lo, hi, lo + k, axis);
+  dacpo_select_points(s->pts, lo, hi, lo + k, axis, &s->rng);
   seg_split(s, lo, lo + k, m1);
   seg_split(s, lo + k, hi, m2);
 }
 
 /* ---------------------------------------------------------------------------
- * Output assembly shared by dacpo_segment and dacpo_segment_single
+ * Output assembly
  * ------------------------------------------------------------------------- */
 
 /* own/own_start from block_of (counting sort over ascending points, so every
@@ -405,15 +364,16 @@ seg_grow(const dacpo_adjacency* adj,
 }
 
 /* Points grouped by component (counting sort, ascending inside a component):
- * component c holds idx[comp_start[c] .. comp_start[c + 1]). */
+ * component c holds pts[comp_start[c] .. comp_start[c + 1]). */
 static dacpo_status
-seg_group_by_component(size_t n,
+seg_group_by_component(const dacpo_cloud* cloud,
                        const int32_t* component,
                        size_t num_components,
                        size_t* comp_start,
-                       int32_t* idx,
+                       dacpo_tree_point* pts,
                        dacpo_err* err)
 {
+  const size_t n = cloud->n;
   for (size_t i = 0; i < n; ++i)
     comp_start[(size_t)component[i] + 1]++;
   for (size_t c = 0; c < num_components; ++c)
@@ -422,8 +382,10 @@ seg_group_by_component(size_t n,
   if (cur == NULL)
     return DACPO_OOM(err);
   memcpy(cur, comp_start, num_components * sizeof(size_t));
-  for (size_t i = 0; i < n; ++i)
-    idx[cur[component[i]]++] = (int32_t)i;
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t id = (int32_t)i;
+    dacpo_tree_points_fill(&pts[cur[component[i]]++], cloud->xyz, &id, 1);
+  }
   free(cur);
 
   return DACPO_OK;
@@ -629,14 +591,14 @@ dacpo_segment(const dacpo_cloud* cloud,
   /* points of each component (see seg_group_by_component), blocks wanted */
   size_t* comp_start = (size_t*)dacpo_calloc_array(num_components + 1, sizeof(size_t));
   size_t* nblk = (size_t*)dacpo_calloc_array(num_components, sizeof(size_t));
-  sp.idx = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
-  if (comp_start == NULL || nblk == NULL || sp.idx == NULL) {
+  sp.pts = (dacpo_tree_point*)dacpo_malloc_array(n, sizeof(dacpo_tree_point));
+  if (comp_start == NULL || nblk == NULL || sp.pts == NULL) {
     st = DACPO_OOM(err);
     goto fail;
   }
 
   if ((st = seg_group_by_component(
-           n, component, num_components, comp_start, sp.idx, err)) != DACPO_OK)
+           cloud, component, num_components, comp_start, sp.pts, err)) != DACPO_OK)
     goto fail;
 
   const size_t total =
@@ -644,7 +606,6 @@ dacpo_segment(const dacpo_cloud* cloud,
 
   /* Unreached points (see seg_grow_blocks) may add at most n - total further
    * blocks, so n slots are enough for all raw blocks. */
-  sp.xyz = cloud->xyz;
   sp.seeds = (int32_t*)dacpo_malloc_array(total, sizeof(int32_t));
   raw_comp = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
   res.block_of = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
@@ -673,63 +634,10 @@ fail:
 done:
   free(comp_start);
   free(nblk);
-  free(sp.idx);
+  free(sp.pts);
   free(sp.seeds);
   free(raw_comp);
   free(queue);
-  return st;
-}
-
-dacpo_status
-dacpo_segment_single(const dacpo_cloud* cloud,
-                     const int32_t* component,
-                     size_t num_components,
-                     dacpo_blocks* out,
-                     dacpo_err* err)
-{
-  if (out != NULL)
-    memset(out, 0, sizeof(*out));
-  DACPO_TRY(seg_check_cloud(cloud, component, num_components, out, err));
-  const size_t n = cloud->n;
-  dacpo_status st = DACPO_OK;
-  dacpo_blocks res;
-  memset(&res, 0, sizeof(res));
-  int32_t* comp_block = (int32_t*)dacpo_malloc_array(num_components, sizeof(int32_t));
-  res.block_of = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
-  if (comp_block == NULL || res.block_of == NULL) {
-    st = DACPO_OOM(err);
-    goto fail;
-  }
-  /* Components without points get no block; the others are numbered in order. */
-  for (size_t c = 0; c < num_components; ++c)
-    comp_block[c] = -1;
-  for (size_t i = 0; i < n; ++i)
-    comp_block[component[i]] = 0;
-  for (size_t c = 0; c < num_components; ++c)
-    if (comp_block[c] == 0)
-      comp_block[c] = (int32_t)res.num_blocks++;
-  res.component_of_block =
-      (int32_t*)dacpo_malloc_array(res.num_blocks, sizeof(int32_t));
-  res.ring_start = (size_t*)dacpo_calloc_array(res.num_blocks + 1, sizeof(size_t));
-  res.ring = (int32_t*)dacpo_malloc_array(0, sizeof(int32_t));
-  if (res.component_of_block == NULL || res.ring_start == NULL || res.ring == NULL) {
-    st = DACPO_OOM(err);
-    goto fail;
-  }
-  for (size_t c = 0; c < num_components; ++c)
-    if (comp_block[c] >= 0)
-      res.component_of_block[comp_block[c]] = (int32_t)c;
-  for (size_t i = 0; i < n; ++i)
-    res.block_of[i] = comp_block[component[i]];
-  if ((st = seg_build_own(n, &res, err)) != DACPO_OK)
-    goto fail;
-  *out = res;
-  free(comp_block);
-  return DACPO_OK;
-
-fail:
-  dacpo_blocks_free(&res);
-  free(comp_block);
   return st;
 }
 

@@ -20,7 +20,8 @@ typedef struct dacpo_blocks {
  * point nearest each subset's centroid as seed, and grows all blocks at once by
  * multi-source BFS over adj: every block is connected in adj. The ring of a block
  * is every point of another block within ring_hops hops of it. Block ids are
- * numbered component by component. */
+ * numbered component by component. target_blocks 0 gives one block per
+ * non-empty component (the paper's "no segmentation" ablation). */
 dacpo_status
 dacpo_segment(const dacpo_cloud* cloud,
               const dacpo_adjacency* adj,
@@ -30,15 +31,6 @@ dacpo_segment(const dacpo_cloud* cloud,
               size_t ring_hops,
               dacpo_blocks* out,
               dacpo_err* err);
-
-/* The "no segmentation" ablation: one block per non-empty component (numbered in
- * component order), own = the component's points, empty rings. */
-dacpo_status
-dacpo_segment_single(const dacpo_cloud* cloud,
-                     const int32_t* component,
-                     size_t num_components,
-                     dacpo_blocks* out,
-                     dacpo_err* err);
 
 /* NULL-safe; frees every array and zeroes the struct. */
 void

@@ -16,8 +16,8 @@
  *  2. rasterize all triangles of both meshes once into one z-buffer (exact
  *     coverage, interpolated depth; dacpo_raster.c);
  *  3. eta = largest depth span max D(v) - min D(v) of a triangle that owns at
- *     least one pixel (params->eta_all: of every triangle, the paper's formula);
- *     optional removal of partly visible triangles; seam closing: empty pixels
+ *     least one pixel (params->experiment.eta_all: of every triangle, the paper's
+ * formula); optional removal of partly visible triangles; seam closing: empty pixels
  *     within r = max(gap_fill, gap_fill_edges * median edge) pixels of drawn ones
  *     copy the nearest (two block meshes cut face by face meet with seams about
  *     one face wide, which would otherwise cut every VCR at the block boundary);
@@ -79,8 +79,6 @@ dacpo_vcr_params_default(dacpo_vcr_params* p)
   p->boundary_factor = 1;
   p->gap_fill = 2;
   p->gap_fill_edges = 0.75;
-  p->drop_partial = 0;
-  p->eta_all = 0;
 }
 
 void
@@ -130,7 +128,7 @@ typedef struct vcr_work {
   double* scr;        /* 3 * nv: pixel x, y, screen-linear z */
   double* vdepth;     /* nv: depth along the view direction */
   uint8_t* back;      /* nt: 1 if the face normal points away from the camera */
-  int32_t* covered;   /* nt: pixel centres covered (drop_partial) */
+  int32_t* covered;   /* nt: pixel centres covered (experiment.drop_partial) */
   int32_t* owned;     /* nt: pixels won */
   int32_t* parent;    /* N^2: pixel union-find */
   uint8_t* cls;       /* N^2: 0 empty, else 1 + 2 * mesh + back */
@@ -457,9 +455,9 @@ view_eta(vcr_work* w, const dacpo_vcr_params* prm)
   double eta = 0.0;
   for (size_t t = 0; t < w->nt; ++t) {
     int retained = w->owned[t] > 0;
-    if (prm->drop_partial)
+    if (prm->experiment.drop_partial)
       retained = retained && w->owned[t] == w->covered[t];
-    if (!retained && !prm->eta_all)
+    if (!retained && !prm->experiment.eta_all)
       continue;
     double z0 = w->vdepth[corner(w, t, 0)], z1 = w->vdepth[corner(w, t, 1)],
            z2 = w->vdepth[corner(w, t, 2)];
@@ -469,7 +467,7 @@ view_eta(vcr_work* w, const dacpo_vcr_params* prm)
     double span = hi - lo;
     eta = span > eta ? span : eta;
   }
-  if (prm->drop_partial) {
+  if (prm->experiment.drop_partial) {
     for (size_t y = R->y0; y <= R->y1; ++y)
       for (size_t x = R->x0; x <= R->x1; ++x) {
         size_t p = y * N + x;

@@ -6,27 +6,32 @@
 
 #include "dacpo_internal.h"
 
+/* Paper variants kept only for comparison runs (the VCR tests and bench_vcr):
+ * measured no better than the defaults, so neither dacpo_params nor the tools
+ * reach them. Both 0 by default. */
+typedef struct dacpo_vcr_experiment {
+  int drop_partial; /* 1: remove the pixels of triangles that are only partly
+                       visible (paper Fig. "VCR" (b, e)) */
+  int eta_all;      /* 0: eta = largest depth span of the triangles that own at
+                       least one pixel; 1: of all triangles (paper's formula) */
+} dacpo_vcr_experiment;
+
 typedef struct dacpo_vcr_params {
   size_t image_size;   /* 400 */
   size_t num_views;    /* 12 (dodecahedron face centres) */
   int perspective;     /* 0 orthographic, 1 perspective */
   int boundary_factor; /* 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 */
   /* Seam closing (defaults from dacpo_vcr_params_default): */
-  size_t gap_fill; /* 2: empty pixels within this many 4-steps of a drawn pixel
-                      take the nearest neighbour's depth and triangle, so a seam
-                      of up to 2*gap_fill pixels between the two meshes still
-                      joins them; 0 = off */
-  /* Paper variants kept for comparison (measured no better; only tests set
-   * them): */
-  int drop_partial;      /* 0; 1: remove the pixels of triangles that are only partly
-                            visible (paper Fig. "VCR" (b, e)) */
-  int eta_all;           /* 0: eta = largest depth span of the triangles that own at
-                            least one pixel; 1: of all triangles (paper's formula) */
+  size_t gap_fill;       /* 2: empty pixels within this many 4-steps of a drawn pixel
+                            take the nearest neighbour's depth and triangle, so a seam
+                            of up to 2*gap_fill pixels between the two meshes still
+                            joins them; 0 = off */
   double gap_fill_edges; /* 0.75: per view, the seam closing reaches at least
                             this many median triangle edges (converted to pixels,
                             at most DACPO_VCR_GAP_MAX): block meshes cut face by
                             face can leave seams about one face wide (the stage-3
                             meshes of the 15 scans did not need it); 0 = off */
+  dacpo_vcr_experiment experiment; /* paper variants, off (above) */
 } dacpo_vcr_params;
 
 /* Upper bound (pixels) of the seam closing chosen by gap_fill_edges. */

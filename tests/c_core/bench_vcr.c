@@ -110,7 +110,7 @@ main(int argc, char** argv)
   v[3].p.gap_fill = 0;
   v[3].p.gap_fill_edges = 0.0;
   v[4].name = "drop_partial";
-  v[4].p.drop_partial = 1;
+  v[4].p.experiment.drop_partial = 1;
   v[5].name = "image 800";
   v[5].p.image_size = 800;
   for (int i = 0; i < 6; ++i) {

@@ -314,7 +314,7 @@ TEST(DacpoIpsr, TrimmingFloodsFromTheRimOnly)
     dacpo_ipsr_params prm;
     dacpo_ipsr_params_default(&prm);
     prm.band = 12;
-    prm.trim_interior = interior;
+    prm.experiment.trim_interior = interior;
     IpsrRun r;
     run(&c, prm, &r);
     HoleCounts h = count_hole_faces(r, prm.trim_spacings * r.stats.spacing, hole, gap);

@@ -13,6 +13,7 @@
 
 extern "C" {
 #include "dacpo_mcubes.h"
+#include "mcubes_once.hpp"
 }
 
 namespace {
@@ -110,8 +111,7 @@ TEST(DacpoMcubes, SphereIsClosedAccurateAndWoundOutward)
   });
   MeshHolder h;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, R, &h.m, &err), DACPO_OK)
-      << err.msg;
+  ASSERT_EQ(mcubes_once(&g.g, g.v.data(), nullptr, R, &h.m, &err), DACPO_OK) << err.msg;
   ASSERT_GT(h.m.num_triangles, 500u);
   // Indexed and watertight: V - E + F = 2 for a sphere, no rim, no clashes.
   EdgeCensus e = census(h.m);
@@ -140,7 +140,7 @@ TEST(DacpoMcubes, PlaneFaceNormalsPointToHigherValues)
   g.fill([](const double* p) { return 2.0 - p[2]; }); // high below z = 2 - iso
   MeshHolder h;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, 0.3, &h.m, &err), DACPO_OK);
+  ASSERT_EQ(mcubes_once(&g.g, g.v.data(), nullptr, 0.3, &h.m, &err), DACPO_OK);
   ASSERT_GT(h.m.num_triangles, 0u);
   for (size_t f = 0; f < h.m.num_triangles; ++f) {
     double n[3], c[3];
@@ -225,7 +225,7 @@ TEST(DacpoMcubes, OneVertexPerCrossedEdge)
       }
   MeshHolder h;
   dacpo_err err{};
-  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, 0.1, &h.m, &err), DACPO_OK);
+  ASSERT_EQ(mcubes_once(&g.g, g.v.data(), nullptr, 0.1, &h.m, &err), DACPO_OK);
   // One vertex per crossed edge, plus a centroid for the rare loop through
   // both segments of an ambiguous face; no two vertices coincide.
   EXPECT_GE(h.m.num_vertices, crossed);
@@ -243,14 +243,13 @@ TEST(DacpoMcubes, EmptyAndDegenerateInputs)
   Grid g(5, 5, 5, 1.0, 0, 0, 0);
   g.fill([](const double*) { return 1.0; });
   MeshHolder h;
-  ASSERT_EQ(dacpo_mcubes_run(&g.g, g.v.data(), nullptr, 0.5, &h.m, &err), DACPO_OK);
+  ASSERT_EQ(mcubes_once(&g.g, g.v.data(), nullptr, 0.5, &h.m, &err), DACPO_OK);
   EXPECT_EQ(h.m.num_triangles, 0u);
   Grid flat(5, 5, 1, 1.0, 0, 0, 0); // a single layer has no cubes
   MeshHolder h2;
-  ASSERT_EQ(dacpo_mcubes_run(&flat.g, flat.v.data(), nullptr, 0.5, &h2.m, &err),
-            DACPO_OK);
+  ASSERT_EQ(mcubes_once(&flat.g, flat.v.data(), nullptr, 0.5, &h2.m, &err), DACPO_OK);
   EXPECT_EQ(h2.m.num_triangles, 0u);
-  EXPECT_EQ(dacpo_mcubes_run(nullptr, g.v.data(), nullptr, 0.5, &h.m, &err),
+  EXPECT_EQ(mcubes_once(nullptr, g.v.data(), nullptr, 0.5, &h.m, &err),
             DACPO_ERR_INVALID_ARGUMENT);
   dacpo_mcubes* mc = nullptr;
   ASSERT_EQ(dacpo_mcubes_create(&mc, &err), DACPO_OK);

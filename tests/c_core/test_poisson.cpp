@@ -13,6 +13,7 @@
 extern "C" {
 #include "dacpo_mcubes.h"
 #include "dacpo_poisson.h"
+#include "mcubes_once.hpp"
 }
 
 namespace {
@@ -123,12 +124,12 @@ solve(const Samples& s, double spacing, Solved* out, double cell_per_spacing = 1
       << err.msg;
   ASSERT_EQ(dacpo_poisson_solve(out->ps, s.n.data(), &out->info, &err), DACPO_OK)
       << err.msg;
-  ASSERT_EQ(dacpo_mcubes_run(dacpo_poisson_grid(out->ps),
-                             dacpo_poisson_values(out->ps),
-                             dacpo_poisson_domain(out->ps),
-                             out->info.iso_value,
-                             &out->mesh,
-                             &err),
+  ASSERT_EQ(mcubes_once(dacpo_poisson_grid(out->ps),
+                        dacpo_poisson_values(out->ps),
+                        dacpo_poisson_domain(out->ps),
+                        out->info.iso_value,
+                        &out->mesh,
+                        &err),
             DACPO_OK)
       << err.msg;
   ASSERT_GT(out->mesh.num_triangles, 0u);
@@ -314,12 +315,12 @@ TEST(DacpoPoisson, NarrowBandMatchesWholeBoxNearTheData)
   ASSERT_EQ(dacpo_poisson_solve(box, s.n.data(), &ix, &err), DACPO_OK);
   EXPECT_LT(dacpo_poisson_domain_cells(band), dacpo_poisson_domain_cells(box) / 2);
   dacpo_mesh m{};
-  ASSERT_EQ(dacpo_mcubes_run(dacpo_poisson_grid(band),
-                             dacpo_poisson_values(band),
-                             dacpo_poisson_domain(band),
-                             ib.iso_value,
-                             &m,
-                             &err),
+  ASSERT_EQ(mcubes_once(dacpo_poisson_grid(band),
+                        dacpo_poisson_values(band),
+                        dacpo_poisson_domain(band),
+                        ib.iso_value,
+                        &m,
+                        &err),
             DACPO_OK);
   ASSERT_GT(m.num_vertices, 1000u);
   double worst = 0;

@@ -445,6 +445,8 @@ TEST(DacpoSegment, TargetZeroMeansOneBlockPerComponent)
   dacpo_blocks_free(&b);
 }
 
+// The paper's "no segmentation" ablation is target 0: one block per non-empty
+// component, numbered in component order, own points ascending.
 TEST(DacpoSegment, SingleBlockPerComponentAblation)
 {
   Scene s;
@@ -456,7 +458,8 @@ TEST(DacpoSegment, SingleBlockPerComponentAblation)
   s.finish();
   dacpo_blocks b{};
   dacpo_err err{};
-  ASSERT_EQ(dacpo_segment_single(&s.cloud, s.component.data(), 3, &b, &err), DACPO_OK)
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 3, 0, 0, &b, &err),
+            DACPO_OK)
       << err.msg;
   ASSERT_EQ(b.num_blocks, 2u);
   EXPECT_EQ(b.component_of_block[0], 0);
@@ -522,7 +525,7 @@ TEST(DacpoSegment, BadArgumentsAreRejected)
             DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 2, 1, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
-  EXPECT_EQ(dacpo_segment_single(&s.cloud, nullptr, 1, &b, &err),
+  EXPECT_EQ(dacpo_segment(&s.cloud, &s.adj, nullptr, 1, 2, 1, &b, &err),
             DACPO_ERR_INVALID_ARGUMENT);
 
   s.component[7] = 3; // outside [0, 1)

@@ -265,10 +265,10 @@ variants()
   p.gap_fill_edges = 0;
   out.push_back(p);
   dacpo_vcr_params_default(&p);
-  p.drop_partial = 1;
+  p.experiment.drop_partial = 1;
   out.push_back(p);
   dacpo_vcr_params_default(&p);
-  p.eta_all = 1;
+  p.experiment.eta_all = 1;
   out.push_back(p);
   dacpo_vcr_params_default(&p);
   p.num_views = 20; // Fibonacci sphere
@@ -289,8 +289,8 @@ name(const dacpo_vcr_params& p)
            p.boundary_factor,
            p.gap_fill,
            p.gap_fill_edges,
-           p.drop_partial,
-           p.eta_all);
+           p.experiment.drop_partial,
+           p.experiment.eta_all);
   return buf;
 }
 
@@ -526,7 +526,7 @@ TEST(DacpoVcr, OverlappingMeshesStillJoin)
     p[0] = -0.15 + 1.15 * u, p[1] = w, p[2] = 0.002 + 0.001 * sin(20 * w);
   });
   for (const auto& p : variants()) {
-    if (p.drop_partial)
+    if (p.experiment.drop_partial)
       continue; // interleaved triangles are all partly hidden: see the note below
     expect_consistent(
         posed(a), posed(b), &p, ("overlapping sheets, " + name(p)).c_str());
@@ -536,7 +536,7 @@ TEST(DacpoVcr, OverlappingMeshesStillJoin)
   dacpo_vcr_params_default(&p);
   Mesh pa = posed(a), pb = posed(b);
   Result keep = edge(pa, pb, &p);
-  p.drop_partial = 1;
+  p.experiment.drop_partial = 1;
   Result drop = edge(pa, pb, &p);
   EXPECT_LT(drop.alpha, keep.alpha);
 }
