@@ -15,9 +15,10 @@
  */
 #include "dacpo_ply.h"
 
+#include "dacpo_support_err.h"
+
 #include <errno.h>
 #include <limits.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,17 +29,6 @@
 #define PLY_MAX_ELEMENTS 64
 #define PLY_MAX_PROPS 128
 #define PLY_BUF_SIZE 65536
-
-static void
-ply_err(char* err, size_t errlen, const char* fmt, ...)
-{
-  va_list ap;
-  if (!err || errlen == 0)
-    return;
-  va_start(ap, fmt);
-  vsnprintf(err, errlen, fmt, ap);
-  va_end(ap);
-}
 
 /* ------------------------------------------------------------------------- */
 /* Writer.                                                                    */
@@ -92,17 +82,19 @@ dacpo_ply_write(const char* path,
   if (err && errlen > 0)
     err[0] = '\0';
   if (!path || (!xyz && n > 0)) {
-    ply_err(err, errlen, "dacpo_ply_write: %s is NULL", !path ? "path" : "xyz");
+    dacpo_support_err(
+        err, errlen, "dacpo_ply_write: %s is NULL", !path ? "path" : "xyz");
     return DACPO_PLY_ERR_ARGUMENT;
   }
   buf = (unsigned char*)malloc(chunk * per * 4);
   if (!buf) {
-    ply_err(err, errlen, "out of memory");
+    dacpo_support_err(err, errlen, "out of memory");
     return DACPO_PLY_ERR_MEMORY;
   }
   f = fopen(path, "wb");
   if (!f) {
-    ply_err(err, errlen, "cannot open '%s' for writing: %s", path, strerror(errno));
+    dacpo_support_err(
+        err, errlen, "cannot open '%s' for writing: %s", path, strerror(errno));
     free(buf);
     return DACPO_PLY_ERR_IO;
   }
@@ -132,12 +124,13 @@ dacpo_ply_write(const char* path,
   }
   free(buf);
   if (bad) {
-    ply_err(err, errlen, "write error on '%s': %s", path, strerror(errno));
+    dacpo_support_err(err, errlen, "write error on '%s': %s", path, strerror(errno));
     fclose(f);
     return DACPO_PLY_ERR_IO;
   }
   if (fclose(f) != 0) {
-    ply_err(err, errlen, "write error on '%s' (close): %s", path, strerror(errno));
+    dacpo_support_err(
+        err, errlen, "write error on '%s' (close): %s", path, strerror(errno));
     return DACPO_PLY_ERR_IO;
   }
   return DACPO_PLY_OK;
@@ -438,11 +431,11 @@ header_format(ply_header* h, char** tok, int nt, int lineno, char* err, size_t e
 {
   if (nt < 2 || (strcmp(tok[1], "ascii") && strcmp(tok[1], "binary_little_endian") &&
                  strcmp(tok[1], "binary_big_endian"))) {
-    ply_err(err,
-            errlen,
-            "unsupported PLY format '%s' (line %d)",
-            nt > 1 ? tok[1] : "",
-            lineno);
+    dacpo_support_err(err,
+                      errlen,
+                      "unsupported PLY format '%s' (line %d)",
+                      nt > 1 ? tok[1] : "",
+                      lineno);
     return DACPO_PLY_ERR_FORMAT;
   }
   h->format = strcmp(tok[1], "ascii") == 0                  ? FMT_ASCII
@@ -457,23 +450,24 @@ header_element(ply_header* h, char** tok, int nt, int lineno, char* err, size_t 
 {
   ply_element* e;
   if (nt != 3) {
-    ply_err(err, errlen, "bad element line %d", lineno);
+    dacpo_support_err(err, errlen, "bad element line %d", lineno);
     return DACPO_PLY_ERR_FORMAT;
   }
   if (h->nel >= PLY_MAX_ELEMENTS) {
-    ply_err(err, errlen, "more than %d elements in the PLY header", PLY_MAX_ELEMENTS);
+    dacpo_support_err(
+        err, errlen, "more than %d elements in the PLY header", PLY_MAX_ELEMENTS);
     return DACPO_PLY_ERR_FORMAT;
   }
   e = &h->el[h->nel++];
   memset(e, 0, sizeof(*e));
   snprintf(e->name, sizeof(e->name), "%s", tok[1]);
   if (parse_count(tok[2], &e->count) != 0) {
-    ply_err(err,
-            errlen,
-            "bad count '%s' for element '%s' (line %d)",
-            tok[2],
-            e->name,
-            lineno);
+    dacpo_support_err(err,
+                      errlen,
+                      "bad count '%s' for element '%s' (line %d)",
+                      tok[2],
+                      e->name,
+                      lineno);
     return DACPO_PLY_ERR_FORMAT;
   }
   return DACPO_PLY_OK;
@@ -487,11 +481,11 @@ header_property(ply_header* h, char** tok, int nt, int lineno, char* err, size_t
   ply_element* e = h->nel > 0 ? &h->el[h->nel - 1] : NULL;
   ply_prop* p;
   if (!e) {
-    ply_err(err, errlen, "property before any element (line %d)", lineno);
+    dacpo_support_err(err, errlen, "property before any element (line %d)", lineno);
     return DACPO_PLY_ERR_FORMAT;
   }
   if (e->nprops >= PLY_MAX_PROPS) {
-    ply_err(
+    dacpo_support_err(
         err, errlen, "more than %d properties in element '%s'", PLY_MAX_PROPS, e->name);
     return DACPO_PLY_ERR_FORMAT;
   }
@@ -502,7 +496,7 @@ header_property(ply_header* h, char** tok, int nt, int lineno, char* err, size_t
     p->role = -1;
     if (p->count_type == T_NONE || p->count_type == T_F32 || p->count_type == T_F64 ||
         p->type == T_NONE) {
-      ply_err(err, errlen, "bad list property types on line %d", lineno);
+      dacpo_support_err(err, errlen, "bad list property types on line %d", lineno);
       return DACPO_PLY_ERR_FORMAT;
     }
   }
@@ -511,12 +505,13 @@ header_property(ply_header* h, char** tok, int nt, int lineno, char* err, size_t
     p->type = parse_type(tok[1]);
     p->role = prop_role(tok[2]);
     if (p->type == T_NONE) {
-      ply_err(err, errlen, "unknown property type '%s' on line %d", tok[1], lineno);
+      dacpo_support_err(
+          err, errlen, "unknown property type '%s' on line %d", tok[1], lineno);
       return DACPO_PLY_ERR_FORMAT;
     }
   }
   else {
-    ply_err(err, errlen, "bad property line %d", lineno);
+    dacpo_support_err(err, errlen, "bad property line %d", lineno);
     return DACPO_PLY_ERR_FORMAT;
   }
   e->nprops++;
@@ -530,7 +525,7 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
   int have_format = 0;
   int rc = in_line(in, line, sizeof(line));
   if (rc != 0 || strcmp(line, "ply") != 0) {
-    ply_err(err, errlen, "not a PLY file (first line is not 'ply')");
+    dacpo_support_err(err, errlen, "not a PLY file (first line is not 'ply')");
     return DACPO_PLY_ERR_FORMAT;
   }
   for (int lineno = 2; lineno < PLY_MAX_HEADER_LINES; ++lineno) {
@@ -539,15 +534,15 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
     int status;
     rc = in_line(in, line, sizeof(line));
     if (rc == -1) {
-      ply_err(err, errlen, "PLY header ends before 'end_header'");
+      dacpo_support_err(err, errlen, "PLY header ends before 'end_header'");
       return DACPO_PLY_ERR_FORMAT;
     }
     if (rc == -2) {
-      ply_err(err,
-              errlen,
-              "PLY header line %d is longer than %d bytes",
-              lineno,
-              PLY_MAX_LINE - 1);
+      dacpo_support_err(err,
+                        errlen,
+                        "PLY header line %d is longer than %d bytes",
+                        lineno,
+                        PLY_MAX_LINE - 1);
       return DACPO_PLY_ERR_FORMAT;
     }
     if (strncmp(line, "comment", 7) == 0 || strncmp(line, "obj_info", 8) == 0)
@@ -557,7 +552,7 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
       continue;
     if (strcmp(tok[0], "end_header") == 0) {
       if (!have_format) {
-        ply_err(err, errlen, "PLY header has no 'format' line");
+        dacpo_support_err(err, errlen, "PLY header has no 'format' line");
         return DACPO_PLY_ERR_FORMAT;
       }
       return DACPO_PLY_OK;
@@ -571,14 +566,15 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
     else if (strcmp(tok[0], "property") == 0)
       status = header_property(h, tok, nt, lineno, err, errlen);
     else {
-      ply_err(
+      dacpo_support_err(
           err, errlen, "unknown PLY header keyword '%s' on line %d", tok[0], lineno);
       status = DACPO_PLY_ERR_FORMAT;
     }
     if (status != DACPO_PLY_OK)
       return status;
   }
-  ply_err(err, errlen, "PLY header longer than %d lines", PLY_MAX_HEADER_LINES);
+  dacpo_support_err(
+      err, errlen, "PLY header longer than %d lines", PLY_MAX_HEADER_LINES);
   return DACPO_PLY_ERR_FORMAT;
 }
 
@@ -671,14 +667,14 @@ find_vertex(const ply_header* h,
     if (strcmp(h->el[i].name, "vertex") == 0)
       *vert = &h->el[i];
   if (!*vert) {
-    ply_err(err, errlen, "'%s' has no 'vertex' element", path);
+    dacpo_support_err(err, errlen, "'%s' has no 'vertex' element", path);
     return DACPO_PLY_ERR_FORMAT;
   }
   for (int j = 0; j < (*vert)->nprops; ++j)
     if ((*vert)->props[j].role >= 0)
       has_role[(*vert)->props[j].role] = 1;
   if (!has_role[0] || !has_role[1] || !has_role[2]) {
-    ply_err(err, errlen, "'%s': vertex element lacks x, y or z", path);
+    dacpo_support_err(err, errlen, "'%s': vertex element lacks x, y or z", path);
     return DACPO_PLY_ERR_FORMAT;
   }
   *has_normals = has_role[3] && has_role[4] && has_role[5];
@@ -701,24 +697,24 @@ skip_elements_before(ply_in* in,
     const uint64_t left = (uint64_t)fsize - in->consumed;
     const uint64_t row = min_row_bytes(h->format, e);
     if (row > 0 && e->count > left / row) {
-      ply_err(err,
-              errlen,
-              "'%s' is truncated: element '%s' declares %llu rows",
-              path,
-              e->name,
-              (unsigned long long)e->count);
+      dacpo_support_err(err,
+                        errlen,
+                        "'%s' is truncated: element '%s' declares %llu rows",
+                        path,
+                        e->name,
+                        (unsigned long long)e->count);
       return DACPO_PLY_ERR_FORMAT;
     }
     for (uint64_t i = 0; i < e->count; ++i) {
       const int rc = read_row(in, h->format, e, dummy);
       if (rc != 0) {
-        ply_err(err,
-                errlen,
-                "'%s': %s in element '%s' row %llu",
-                path,
-                rc == -1 ? "unexpected end of file" : "bad value",
-                e->name,
-                (unsigned long long)i);
+        dacpo_support_err(err,
+                          errlen,
+                          "'%s': %s in element '%s' row %llu",
+                          path,
+                          rc == -1 ? "unexpected end of file" : "bad value",
+                          e->name,
+                          (unsigned long long)i);
         return DACPO_PLY_ERR_FORMAT;
       }
     }
@@ -743,14 +739,15 @@ check_vertex_count(const ply_in* in,
   if (format == FMT_ASCII && vert->count > 0 && row > 0)
     need_ok = vert->count <= (left + 1) / row; /* last row may lack its newline */
   if (!need_ok || vert->count > (uint64_t)(SIZE_MAX / (6 * sizeof(float)))) {
-    ply_err(err,
-            errlen,
-            "'%s' is truncated: header declares %llu vertices (at least %llu bytes) "
-            "but only %llu bytes of data follow",
-            path,
-            (unsigned long long)vert->count,
-            (unsigned long long)(vert->count * row),
-            (unsigned long long)left);
+    dacpo_support_err(
+        err,
+        errlen,
+        "'%s' is truncated: header declares %llu vertices (at least %llu bytes) "
+        "but only %llu bytes of data follow",
+        path,
+        (unsigned long long)vert->count,
+        (unsigned long long)(vert->count * row),
+        (unsigned long long)left);
     return DACPO_PLY_ERR_FORMAT;
   }
   return DACPO_PLY_OK;
@@ -773,7 +770,7 @@ read_vertices(ply_in* in,
     if (has_normals)
       c->normals = (float*)malloc(3 * c->n * sizeof(float));
     if (!c->xyz || (has_normals && !c->normals)) {
-      ply_err(err, errlen, "out of memory reading %zu vertices", c->n);
+      dacpo_support_err(err, errlen, "out of memory reading %zu vertices", c->n);
       return DACPO_PLY_ERR_MEMORY;
     }
   }
@@ -781,13 +778,13 @@ read_vertices(ply_in* in,
     double v[6] = {0, 0, 0, 0, 0, 0};
     const int rc = read_row(in, format, vert, v);
     if (rc != 0) {
-      ply_err(err,
-              errlen,
-              "'%s': %s at vertex %zu of %zu",
-              path,
-              rc == -1 ? "unexpected end of file (truncated)" : "bad value",
-              i,
-              c->n);
+      dacpo_support_err(err,
+                        errlen,
+                        "'%s': %s at vertex %zu of %zu",
+                        path,
+                        rc == -1 ? "unexpected end of file (truncated)" : "bad value",
+                        i,
+                        c->n);
       return DACPO_PLY_ERR_FORMAT;
     }
     for (int k = 0; k < 3; ++k)
@@ -806,12 +803,12 @@ open_sized(const char* path, ply_in* in, long* fsize, char* err, size_t errlen)
 {
   in->f = fopen(path, "rb");
   if (!in->f) {
-    ply_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+    dacpo_support_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
     return DACPO_PLY_ERR_IO;
   }
   if (fseek(in->f, 0, SEEK_END) != 0 || (*fsize = ftell(in->f)) < 0 ||
       fseek(in->f, 0, SEEK_SET) != 0) {
-    ply_err(
+    dacpo_support_err(
         err, errlen, "cannot determine the size of '%s' (not a regular file?)", path);
     fclose(in->f);
     return DACPO_PLY_ERR_IO;
@@ -835,7 +832,8 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   if (out)
     memset(out, 0, sizeof(*out));
   if (!path || !out) {
-    ply_err(err, errlen, "dacpo_ply_read: %s is NULL", !path ? "path" : "out");
+    dacpo_support_err(
+        err, errlen, "dacpo_ply_read: %s is NULL", !path ? "path" : "out");
     return DACPO_PLY_ERR_ARGUMENT;
   }
   memset(&in, 0, sizeof(in));
@@ -847,7 +845,7 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   in.buf = (unsigned char*)malloc(PLY_BUF_SIZE);
   h.el = (ply_element*)malloc(PLY_MAX_ELEMENTS * sizeof(ply_element));
   if (!in.buf || !h.el) {
-    ply_err(err, errlen, "out of memory");
+    dacpo_support_err(err, errlen, "out of memory");
     status = DACPO_PLY_ERR_MEMORY;
     goto done;
   }
@@ -865,7 +863,7 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   if (status != DACPO_PLY_OK)
     goto done;
   if (ferror(in.f)) {
-    ply_err(err, errlen, "read error on '%s'", path);
+    dacpo_support_err(err, errlen, "read error on '%s'", path);
     status = DACPO_PLY_ERR_IO;
     goto done;
   }

@@ -24,9 +24,9 @@
 #include "dacpo_scene.h"
 
 #include "dacpo_rng.h"
+#include "dacpo_support_err.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -652,17 +652,6 @@ static const scene_entry scene_table[DACPO_SCENE_KIND_COUNT] = {
 /* ------------------------------------------------------------------------- */
 /* Public functions.                                                          */
 
-static void
-set_err(char* err, size_t errlen, const char* fmt, ...)
-{
-  va_list ap;
-  if (!err || errlen == 0)
-    return;
-  va_start(ap, fmt);
-  vsnprintf(err, errlen, fmt, ap);
-  va_end(ap);
-}
-
 const char*
 dacpo_scene_kind_name(unsigned kind)
 {
@@ -807,28 +796,29 @@ check_scene_params(const dacpo_scene_params* params, char* err, size_t errlen)
 {
   const size_t n = params->target_points;
   if (params->kind >= DACPO_SCENE_KIND_COUNT) {
-    set_err(err,
-            errlen,
-            "unknown scene kind %u (valid: 0..%d)",
-            params->kind,
-            DACPO_SCENE_KIND_COUNT - 1);
+    dacpo_support_err(err,
+                      errlen,
+                      "unknown scene kind %u (valid: 0..%d)",
+                      params->kind,
+                      DACPO_SCENE_KIND_COUNT - 1);
     return SCENE_ERR_INVALID;
   }
   if (n == 0 || n > SCENE_MAX_POINTS || n > SIZE_MAX / (3 * sizeof(float))) {
-    set_err(
+    dacpo_support_err(
         err, errlen, "target_points %zu out of range (1..%zu)", n, SCENE_MAX_POINTS);
     return SCENE_ERR_INVALID;
   }
   if (!(params->noise_sigma >= 0.0) || !isfinite(params->noise_sigma)) {
-    set_err(err, errlen, "noise_sigma %g must be finite and >= 0", params->noise_sigma);
+    dacpo_support_err(
+        err, errlen, "noise_sigma %g must be finite and >= 0", params->noise_sigma);
     return SCENE_ERR_INVALID;
   }
   if (params->downsample_to > n) {
-    set_err(err,
-            errlen,
-            "downsample_to %zu exceeds target_points %zu",
-            params->downsample_to,
-            n);
+    dacpo_support_err(err,
+                      errlen,
+                      "downsample_to %zu exceeds target_points %zu",
+                      params->downsample_to,
+                      n);
     return SCENE_ERR_INVALID;
   }
   return 0;
@@ -885,7 +875,7 @@ dacpo_scene_generate(const dacpo_scene_params* params,
   if (out)
     memset(out, 0, sizeof(*out));
   if (!params || !out) {
-    set_err(
+    dacpo_support_err(
         err, errlen, "dacpo_scene_generate: %s is NULL", !params ? "params" : "out");
     return SCENE_ERR_INVALID;
   }
@@ -900,10 +890,10 @@ dacpo_scene_generate(const dacpo_scene_params* params,
     goto oom;
   scene_table[params->kind].build(&b);
   if (b.overflow || b.count == 0) {
-    set_err(err,
-            errlen,
-            "internal error: scene '%s' exceeds the builder's limits",
-            scene_table[params->kind].name);
+    dacpo_support_err(err,
+                      errlen,
+                      "internal error: scene '%s' exceeds the builder's limits",
+                      scene_table[params->kind].name);
     status = SCENE_ERR_INVALID;
     goto done;
   }
@@ -934,7 +924,7 @@ dacpo_scene_generate(const dacpo_scene_params* params,
   goto done;
 
 oom:
-  set_err(err, errlen, "out of memory generating %zu points", n);
+  dacpo_support_err(err, errlen, "out of memory generating %zu points", n);
   status = SCENE_ERR_NOMEM;
 done:
   dacpo_scene_free(&s);

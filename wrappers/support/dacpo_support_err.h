@@ -1,0 +1,16 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* The error text of the support library (PLY I/O, scenes): printf-style into
+ * the caller's buffer, nothing when err is NULL or errlen is 0. Private to
+ * wrappers/support. */
+#ifndef DACPO_SUPPORT_ERR_H
+#define DACPO_SUPPORT_ERR_H
+
+#include <stddef.h>
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+void
+dacpo_support_err(char* err, size_t errlen, const char* fmt, ...);
+
+#endif /* DACPO_SUPPORT_ERR_H */
