@@ -8,6 +8,8 @@
  * touches the context; stages report through dacpo_err.
  * Failure modes: every stage's status is passed through unchanged; the caller's
  * normals are written only after everything succeeded. */
+#include <dacpo/dacpo_advanced.h>
+
 #include "dacpo_block_graph.h"
 #include "dacpo_bridge.h"
 #include "dacpo_context.h"
@@ -25,6 +27,7 @@
 #include "dacpo_vcr.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -885,9 +888,10 @@ segment_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
   return DACPO_OK;
 }
 
-/* Stages 2 and 3: one parallel pass over the blocks (independent per block). */
+/* The per-point and per-block results stages 2 and 3 fill in, block by
+ * block. */
 static dacpo_status
-orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
+alloc_block_results(run_state* s, dacpo_err* err)
 {
   const size_t nb = s->blocks.num_blocks;
   s->oriented = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
@@ -904,6 +908,14 @@ orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
   if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
       !s->cue_votes || (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
     return DACPO_OOM(err);
+  return DACPO_OK;
+}
+
+/* Stages 2 and 3: one parallel pass over the blocks (independent per block). */
+static dacpo_status
+orient_blocks(run_state* s, dacpo_err* err)
+{
+  const size_t nb = s->blocks.num_blocks;
   DACPO_TRY(
       dacpo_parallel_for(nb,
                          s->p.num_threads,
@@ -912,11 +924,6 @@ orient_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
                          s->progress,
                          s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
                          err));
-  for (size_t b = 0; b < nb; ++b) {
-    st->ipsr_iterations_total += s->ipsr[b].iterations;
-    if (s->ipsr[b].iterations > st->ipsr_iterations_max)
-      st->ipsr_iterations_max = s->ipsr[b].iterations;
-  }
   return DACPO_OK;
 }
 
@@ -942,68 +949,231 @@ weigh_edges(run_state* s, dacpo_err* err)
   return DACPO_OK;
 }
 
-static dacpo_status
-run(dacpo_ctx* ctx,
-    run_state* s,
-    const dacpo_search* search,
-    const float* xyz,
-    float* normals,
-    size_t count,
-    dacpo_err* err)
-{
-  dacpo_stats* st = &ctx->stats;
-  double t = dacpo_now();
-#define STAGE_DONE(stage)                                                              \
-  do {                                                                                 \
-    double now_ = dacpo_now();                                                         \
-    st->stage_seconds[stage] = now_ - t;                                               \
-    t = now_;                                                                          \
-    DACPO_TRY(report(s, (stage), 1.0, err));                                           \
-  } while (0)
+/* ---- the run as work units (dacpo_advanced.h) ---------------------------- */
 
+struct dacpo_job {
+  dacpo_ctx* ctx;
+  run_state s;
+  double t0; /* start of the run */
+  double t;  /* end of the last stage timed */
+};
+
+/* Records the wall time of `stage` since the last one and asks the progress
+ * callback whether to go on. */
+static dacpo_status
+stage_done(dacpo_job* job, dacpo_stage stage, dacpo_err* err)
+{
+  const double now = dacpo_now();
+  job->ctx->stats.stage_seconds[stage] = now - job->t;
+  job->t = now;
+  return report(&job->s, stage, 1.0, err);
+}
+
+/* A failed step: the stats of the stages that ran stay, partial per-point
+ * results go, the message goes to the context. */
+static dacpo_status
+job_fail(dacpo_ctx* ctx, dacpo_status status, dacpo_err* err)
+{
+  if (err->code != status || err->msg[0] == '\0')
+    dacpo_err_set(err, status, "%s", dacpo_status_string(status));
+  dacpo_stats keep = ctx->stats;
+  dacpo_ctx_clear_results(ctx);
+  ctx->stats = keep;
+  return dacpo_ctx_fail(ctx, err);
+}
+
+/* Input and stages 0-1. normals: the given axes (estimate_normals 0); with
+ * out_buffer set they are also the buffer the run writes to, which must exist
+ * even when the normals are estimated. */
+static dacpo_status
+job_prepare(dacpo_job* job,
+            const dacpo_search* search,
+            const float* xyz,
+            const float* normals,
+            int out_buffer,
+            size_t count,
+            dacpo_err* err)
+{
+  run_state* s = &job->s;
+  dacpo_stats* st = &job->ctx->stats;
   DACPO_TRY(report(s, DACPO_STAGE_INPUT, 0.0, err));
   /* count == 0 first: empty std::vectors hand over NULL pointers */
-  DACPO_CHECK(err,
-              count == 0 || normals != NULL,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "normals is NULL: it is the buffer that receives the oriented normals");
+  if (out_buffer)
+    DACPO_CHECK(err,
+                count == 0 || normals != NULL,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "normals is NULL: it is the buffer that receives the oriented normals");
+  else
+    DACPO_CHECK(err,
+                count == 0 || s->p.estimate_normals || normals != NULL,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "normals is NULL but estimate_normals is 0: give the axes");
   const float* given = s->p.estimate_normals ? NULL : normals;
   DACPO_TRY(dacpo_input_check(xyz, given, count, err));
   DACPO_TRY(dacpo_cloud_build(xyz, given, count, &s->cloud, err));
   st->input_points = count;
   st->unique_points = s->cloud.n;
   st->duplicate_points = count - s->cloud.n;
-  STAGE_DONE(DACPO_STAGE_INPUT);
-
+  DACPO_TRY(stage_done(job, DACPO_STAGE_INPUT, err));
   DACPO_TRY(build_neighbors(s, st, search, err));
-  STAGE_DONE(DACPO_STAGE_NEIGHBORS);
-
+  DACPO_TRY(stage_done(job, DACPO_STAGE_NEIGHBORS, err));
   if (s->p.estimate_normals)
     DACPO_TRY(estimate_normals(s, err));
-  STAGE_DONE(DACPO_STAGE_NORMALS);
-
+  DACPO_TRY(stage_done(job, DACPO_STAGE_NORMALS, err));
   DACPO_TRY(segment_blocks(s, st, err));
-  STAGE_DONE(DACPO_STAGE_SEGMENT);
+  DACPO_TRY(alloc_block_results(s, err));
+  return stage_done(job, DACPO_STAGE_SEGMENT, err);
+}
 
-  DACPO_TRY(orient_blocks(s, st, err));
-  const size_t nb = s->blocks.num_blocks;
-  {
-    /* Stages 2 and 3 ran in one parallel pass: split its wall time in
-     * proportion to the summed per-block times of each stage. */
-    double now = dacpo_now(), sum2 = 0.0, sum3 = 0.0;
-    for (size_t b = 0; b < nb; ++b) {
-      sum2 += s->block_seconds[2 * b];
-      sum3 += s->block_seconds[2 * b + 1];
-    }
-    double share2 = sum2 + sum3 > 0.0 ? sum2 / (sum2 + sum3) : 1.0;
-    st->stage_seconds[DACPO_STAGE_DIPOLE] = (now - t) * share2;
-    st->stage_seconds[DACPO_STAGE_IPSR] = (now - t) * (1.0 - share2);
-    t = now;
+static dacpo_status
+job_start(dacpo_ctx* ctx,
+          const dacpo_params* params,
+          const dacpo_search* search,
+          const dacpo_progress* progress,
+          const float* xyz,
+          const float* normals,
+          int out_buffer,
+          size_t count,
+          dacpo_job** out)
+{
+  dacpo_ctx_clear_results(ctx);
+  ctx->last_error[0] = '\0';
+  dacpo_err err = {DACPO_OK, {0}};
+  if (!out) {
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: out is NULL");
+    return dacpo_ctx_fail(ctx, &err);
   }
+  *out = NULL;
+  dacpo_job* job = calloc(1, sizeof(*job));
+  if (!job) {
+    DACPO_OOM(&err);
+    return dacpo_ctx_fail(ctx, &err);
+  }
+  job->ctx = ctx;
+  if (params)
+    job->s.p = *params;
+  else
+    dacpo_params_init(&job->s.p);
+  job->s.progress = progress;
+  char msg[256];
+  dacpo_status status = dacpo_params_validate(&job->s.p, msg, sizeof(msg));
+  if (status != DACPO_OK) {
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "%s", msg);
+    free(job);
+    return dacpo_ctx_fail(ctx, &err);
+  }
+  job->t0 = job->t = dacpo_now();
+  status = job_prepare(job, search, xyz, normals, out_buffer, count, &err);
+  if (status != DACPO_OK) {
+    dacpo_job_free(job);
+    return job_fail(ctx, status, &err);
+  }
+  *out = job;
+  return DACPO_OK;
+}
 
-  DACPO_TRY(weigh_edges(s, err));
-  STAGE_DONE(DACPO_STAGE_EDGE_WEIGHTS);
+dacpo_status
+dacpo_job_create(dacpo_ctx* ctx,
+                 const dacpo_params* params,
+                 const dacpo_search* search,
+                 const dacpo_progress* progress,
+                 const float* xyz,
+                 const float* normals,
+                 size_t count,
+                 dacpo_job** out)
+{
+  if (!ctx)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  return job_start(ctx, params, search, progress, xyz, normals, 0, count, out);
+}
 
+size_t
+dacpo_job_num_blocks(const dacpo_job* job)
+{
+  return job ? job->s.blocks.num_blocks : 0;
+}
+
+size_t
+dacpo_job_num_edges(const dacpo_job* job)
+{
+  return job ? job->s.bgraph.num_edges : 0;
+}
+
+dacpo_status
+dacpo_job_edge_blocks(const dacpo_job* job, size_t e, size_t* a, size_t* b)
+{
+  if (!job || !a || !b || e >= job->s.bgraph.num_edges)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  *a = (size_t)job->s.bgraph.edges[e].a;
+  *b = (size_t)job->s.bgraph.edges[e].b;
+  return DACPO_OK;
+}
+
+/* The message of a unit's failure into the caller's buffer. */
+static dacpo_status
+unit_result(const dacpo_err* err, char* msg, size_t msg_size)
+{
+  if (msg && msg_size > 0)
+    snprintf(msg, msg_size, "%s", err->code != DACPO_OK ? err->msg : "");
+  return err->code;
+}
+
+dacpo_status
+dacpo_job_orient_block(dacpo_job* job, size_t b, char* msg, size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (!job || b >= job->s.blocks.num_blocks)
+    dacpo_err_set(&err,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "job: block %zu of %zu",
+                  b,
+                  dacpo_job_num_blocks(job));
+  else
+    orient_block(&job->s, b, 0, &err);
+  return unit_result(&err, msg, msg_size);
+}
+
+dacpo_status
+dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (!job || e >= job->s.bgraph.num_edges)
+    dacpo_err_set(&err,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "job: edge %zu of %zu",
+                  e,
+                  dacpo_job_num_edges(job));
+  else if (job->s.p.edge_weight != DACPO_WEIGHT_VCR)
+    dacpo_err_set(&err,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "job: edge by edge only with VCR weights; use dacpo_job_weigh_edges");
+  else
+    weigh_edge_vcr(&job->s, e, 0, &err);
+  return unit_result(&err, msg, msg_size);
+}
+
+dacpo_status
+dacpo_job_weigh_edges(dacpo_job* job)
+{
+  if (!job)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  dacpo_err err = {DACPO_OK, {0}};
+  dacpo_status status = weigh_edges(&job->s, &err);
+  return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
+}
+
+/* Stages 5-6 and the parts. */
+static dacpo_status
+job_solve(dacpo_job* job, dacpo_err* err)
+{
+  run_state* s = &job->s;
+  dacpo_stats* st = &job->ctx->stats;
+  st->ipsr_iterations_total = st->ipsr_iterations_max = 0;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    st->ipsr_iterations_total += s->ipsr[b].iterations;
+    if (s->ipsr[b].iterations > st->ipsr_iterations_max)
+      st->ipsr_iterations_max = s->ipsr[b].iterations;
+  }
   DACPO_TRY(solve_flips(s, st, err));
   if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT &&
       (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))
@@ -1011,16 +1181,77 @@ run(dacpo_ctx* ctx,
   DACPO_TRY(choose_global_sign(s, st, err));
   if (s->part_sign)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
-  STAGE_DONE(DACPO_STAGE_ILP);
+  return stage_done(job, DACPO_STAGE_ILP, err);
+}
 
-  if (s->p.keep_mesh) {
-    DACPO_TRY(build_scene_mesh(s, err));
-    STAGE_DONE(DACPO_STAGE_MESH);
+dacpo_status
+dacpo_job_solve(dacpo_job* job)
+{
+  if (!job)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  job->t = dacpo_now();
+  dacpo_err err = {DACPO_OK, {0}};
+  dacpo_status status = job_solve(job, &err);
+  return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
+}
+
+/* The scene mesh (keep_mesh) and the results. */
+static dacpo_status
+job_finish(dacpo_job* job, float* normals, dacpo_err* err)
+{
+  if (job->s.p.keep_mesh) {
+    DACPO_TRY(build_scene_mesh(&job->s, err));
+    DACPO_TRY(stage_done(job, DACPO_STAGE_MESH, err));
   }
-
-  DACPO_TRY(publish(ctx, s, normals, err));
-#undef STAGE_DONE
+  DACPO_TRY(publish(job->ctx, &job->s, normals, err));
+  job->ctx->stats.total_seconds = dacpo_now() - job->t0;
   return DACPO_OK;
+}
+
+dacpo_status
+dacpo_job_finish(dacpo_job* job, float* normals)
+{
+  if (!job)
+    return DACPO_ERR_INVALID_ARGUMENT;
+  dacpo_err err = {DACPO_OK, {0}};
+  DACPO_CHECK(&err,
+              job->s.cloud.input_count == 0 || normals != NULL,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "normals is NULL: it is the buffer that receives the oriented normals");
+  job->t = dacpo_now();
+  dacpo_status status = job_finish(job, normals, &err);
+  return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
+}
+
+void
+dacpo_job_free(dacpo_job* job)
+{
+  if (!job)
+    return;
+  run_state_free(&job->s);
+  free(job);
+}
+
+/* Stages 2-4 of a whole job: the blocks and then the edges in parallel, with
+ * the wall time of the block pass split between stages 2 and 3 in proportion
+ * to their summed per-block times. */
+static dacpo_status
+job_orient_and_weigh(dacpo_job* job, dacpo_err* err)
+{
+  run_state* s = &job->s;
+  dacpo_stats* st = &job->ctx->stats;
+  DACPO_TRY(orient_blocks(s, err));
+  double now = dacpo_now(), sum2 = 0.0, sum3 = 0.0;
+  for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
+    sum2 += s->block_seconds[2 * b];
+    sum3 += s->block_seconds[2 * b + 1];
+  }
+  double share2 = sum2 + sum3 > 0.0 ? sum2 / (sum2 + sum3) : 1.0;
+  st->stage_seconds[DACPO_STAGE_DIPOLE] = (now - job->t) * share2;
+  st->stage_seconds[DACPO_STAGE_IPSR] = (now - job->t) * (1.0 - share2);
+  job->t = now;
+  DACPO_TRY(weigh_edges(s, err));
+  return stage_done(job, DACPO_STAGE_EDGE_WEIGHTS, err);
 }
 
 dacpo_status
@@ -1034,33 +1265,14 @@ dacpo_orient(dacpo_ctx* ctx,
 {
   if (!ctx)
     return DACPO_ERR_INVALID_ARGUMENT;
-  dacpo_ctx_clear_results(ctx);
-  ctx->last_error[0] = '\0';
+  dacpo_job* job = NULL;
+  DACPO_TRY(job_start(ctx, params, search, progress, xyz, normals, 1, count, &job));
   dacpo_err err = {DACPO_OK, {0}};
-  run_state s;
-  memset(&s, 0, sizeof(s));
-  if (params)
-    s.p = *params;
-  else
-    dacpo_params_init(&s.p);
-  s.progress = progress;
-  char msg[256];
-  if (dacpo_params_validate(&s.p, msg, sizeof(msg)) != DACPO_OK) {
-    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "%s", msg);
-    return dacpo_ctx_fail(ctx, &err);
-  }
-  const double t0 = dacpo_now();
-  dacpo_status status = run(ctx, &s, search, xyz, normals, count, &err);
-  run_state_free(&s);
-  if (status != DACPO_OK) {
-    if (err.code != status || err.msg[0] == '\0')
-      dacpo_err_set(&err, status, "%s", dacpo_status_string(status));
-    /* keep the stats of the stages that ran, drop partial per-point results */
-    dacpo_stats keep = ctx->stats;
-    dacpo_ctx_clear_results(ctx);
-    ctx->stats = keep;
-    return dacpo_ctx_fail(ctx, &err);
-  }
-  ctx->stats.total_seconds = dacpo_now() - t0;
-  return DACPO_OK;
+  dacpo_status status = job_orient_and_weigh(job, &err);
+  if (status == DACPO_OK)
+    status = job_solve(job, &err);
+  if (status == DACPO_OK)
+    status = job_finish(job, normals, &err);
+  dacpo_job_free(job);
+  return status == DACPO_OK ? DACPO_OK : job_fail(ctx, status, &err);
 }

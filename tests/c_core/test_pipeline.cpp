@@ -3,8 +3,10 @@
 // with known normals (wrappers/support/dacpo_scene.h): orientation error against
 // ground truth, the per-point / per-block / per-edge results and stats the
 // context publishes, determinism (seed, thread count, caller's search), the
-// progress callback's contract, and that the output keeps the caller's axes.
+// progress callback's contract, that the output keeps the caller's axes, and
+// that the run as work units (dacpo_advanced.h) gives dacpo_orient()'s answer.
 #include <dacpo/dacpo.h>
+#include <dacpo/dacpo_advanced.h>
 
 #include <gtest/gtest.h>
 
@@ -64,22 +66,14 @@ struct Result {
   std::vector<dacpo_edge_info> edges;
 };
 
-Result
-orient(dacpo_ctx* ctx,
-       const dacpo_params& p,
-       const float* xyz,
-       std::vector<float> normals,
-       size_t n,
-       const dacpo_search* search = nullptr,
-       const dacpo_progress* progress = nullptr)
+// What the context holds after a run that returned r.status.
+void
+collect(dacpo_ctx* ctx, Result& r)
 {
-  Result r;
-  r.status = dacpo_orient(ctx, &p, search, progress, xyz, normals.data(), n);
   r.error = dacpo_ctx_last_error(ctx);
-  r.normals = std::move(normals);
   r.stats = *dacpo_ctx_stats(ctx);
   if (r.status != DACPO_OK)
-    return r;
+    return;
   const size_t m = r.stats.input_points;
   if (const int32_t* c = dacpo_ctx_point_components(ctx))
     r.component.assign(c, c + m);
@@ -93,6 +87,21 @@ orient(dacpo_ctx* ctx,
     r.flips.assign(f, f + r.stats.num_blocks);
   if (const dacpo_edge_info* e = dacpo_ctx_edges(ctx))
     r.edges.assign(e, e + r.stats.num_block_edges);
+}
+
+Result
+orient(dacpo_ctx* ctx,
+       const dacpo_params& p,
+       const float* xyz,
+       std::vector<float> normals,
+       size_t n,
+       const dacpo_search* search = nullptr,
+       const dacpo_progress* progress = nullptr)
+{
+  Result r;
+  r.status = dacpo_orient(ctx, &p, search, progress, xyz, normals.data(), n);
+  r.normals = std::move(normals);
+  collect(ctx, r);
   return r;
 }
 
@@ -120,6 +129,27 @@ sameBits(const std::vector<float>& a, const std::vector<float>& b)
 {
   return a.size() == b.size() &&
          (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+// Two runs that must agree bit for bit.
+void
+expectSameRun(const Result& a, const Result& b)
+{
+  ASSERT_EQ(a.status, DACPO_OK) << a.error;
+  ASSERT_EQ(b.status, DACPO_OK) << b.error;
+  EXPECT_TRUE(sameBits(a.normals, b.normals));
+  EXPECT_TRUE(sameBits(a.confidence, b.confidence));
+  EXPECT_EQ(a.block, b.block);
+  EXPECT_EQ(a.component, b.component);
+  EXPECT_EQ(a.flips, b.flips);
+  ASSERT_EQ(a.edges.size(), b.edges.size());
+  for (size_t e = 0; e < a.edges.size(); ++e) {
+    EXPECT_EQ(a.edges[e].alpha, b.edges[e].alpha) << e;
+    EXPECT_EQ(a.edges[e].alpha_bar, b.edges[e].alpha_bar) << e;
+  }
+  EXPECT_EQ(a.stats.num_blocks, b.stats.num_blocks);
+  EXPECT_EQ(a.stats.ipsr_iterations_total, b.stats.ipsr_iterations_total);
+  EXPECT_EQ(a.stats.solver_objective, b.stats.solver_objective);
 }
 
 dacpo_params
@@ -577,18 +607,8 @@ TEST(DacpoPipeline, ThreadCountDoesNotChangeResult)
   Result one = orientScene(sc, p);
   p.num_threads = 2;
   Result two = orientScene(sc, p);
-  ASSERT_EQ(one.status, DACPO_OK) << one.error;
-  ASSERT_EQ(two.status, DACPO_OK) << two.error;
-  EXPECT_TRUE(sameBits(one.normals, two.normals));
+  expectSameRun(one, two);
   EXPECT_TRUE(sameBits(one.curvature, two.curvature));
-  EXPECT_EQ(one.block, two.block);
-  EXPECT_EQ(one.flips, two.flips);
-  ASSERT_EQ(one.edges.size(), two.edges.size());
-  for (size_t e = 0; e < one.edges.size(); ++e) {
-    EXPECT_EQ(one.edges[e].alpha, two.edges[e].alpha) << e;
-    EXPECT_EQ(one.edges[e].alpha_bar, two.edges[e].alpha_bar) << e;
-  }
-  EXPECT_EQ(one.stats.ipsr_iterations_total, two.stats.ipsr_iterations_total);
 }
 
 TEST(DacpoPipeline, CallerSearchMatchesBuiltIn)
@@ -818,4 +838,163 @@ TEST(DacpoPipeline, KeepingTheMeshKeepsTheEdgeWeightMeasure)
     }
     EXPECT_EQ(alpha[0], alpha[1]) << "edge weight " << static_cast<int>(w);
   }
+}
+
+// ---- the run as work units (dacpo_advanced.h) ------------------------------
+
+struct JobDeleter {
+  void
+  operator()(dacpo_job* j) const
+  {
+    dacpo_job_free(j);
+  }
+};
+using JobPtr = std::unique_ptr<dacpo_job, JobDeleter>;
+
+enum class UnitOrder { Reversed, TwoThreads };
+
+// dacpo_orient()'s steps called one by one: blocks and edges last to first, or
+// split between two threads (even and odd ids).
+Result
+orientByUnits(const Scene& sc, const dacpo_params& p, UnitOrder order)
+{
+  auto ctx = makeCtx();
+  Result r;
+  std::vector<float> normals(3 * sc.s.n, 0.0f);
+  dacpo_job* raw = nullptr;
+  r.status = dacpo_job_create(
+      ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, sc.s.n, &raw);
+  JobPtr job(raw);
+  if (r.status != DACPO_OK) {
+    collect(ctx.get(), r);
+    return r;
+  }
+  auto run_units = [&](size_t count, auto unit) {
+    std::vector<dacpo_status> st(count, DACPO_OK);
+    if (order == UnitOrder::Reversed) {
+      for (size_t i = count; i-- > 0;)
+        st[i] = unit(i);
+    }
+    else {
+      std::thread odd([&] {
+        for (size_t i = 1; i < count; i += 2)
+          st[i] = unit(i);
+      });
+      for (size_t i = 0; i < count; i += 2)
+        st[i] = unit(i);
+      odd.join();
+    }
+    for (dacpo_status s : st)
+      if (s != DACPO_OK)
+        return s;
+    return DACPO_OK;
+  };
+  char msg[256];
+  r.status = run_units(dacpo_job_num_blocks(job.get()), [&](size_t b) {
+    return dacpo_job_orient_block(job.get(), b, nullptr, 0);
+  });
+  if (r.status == DACPO_OK && p.edge_weight == DACPO_WEIGHT_VCR)
+    r.status = run_units(dacpo_job_num_edges(job.get()), [&](size_t e) {
+      return dacpo_job_weigh_edge(job.get(), e, nullptr, 0);
+    });
+  else if (r.status == DACPO_OK) {
+    // edge by edge is for VCR only; the other measures weigh all edges at once
+    if (dacpo_job_num_edges(job.get()) > 0) {
+      EXPECT_EQ(dacpo_job_weigh_edge(job.get(), 0, msg, sizeof(msg)),
+                DACPO_ERR_INVALID_ARGUMENT);
+      EXPECT_NE(std::string(msg).find("dacpo_job_weigh_edges"), std::string::npos)
+          << msg;
+    }
+    r.status = dacpo_job_weigh_edges(job.get());
+  }
+  if (r.status == DACPO_OK)
+    r.status = dacpo_job_solve(job.get());
+  if (r.status == DACPO_OK)
+    r.status = dacpo_job_finish(job.get(), normals.data());
+  r.normals = std::move(normals);
+  collect(ctx.get(), r);
+  return r;
+}
+
+TEST(DacpoJob, UnitsInAnyOrderGiveTheAnswerOfOrient)
+{
+  Scene sc(DACPO_SCENE_ROOM, 12000, 3);
+  ASSERT_TRUE(sc.ok);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  p.num_blocks = 12;
+  Result whole = orientScene(sc, p);
+  ASSERT_GT(whole.stats.num_block_edges, 10u);
+  expectSameRun(whole, orientByUnits(sc, p, UnitOrder::Reversed));
+  expectSameRun(whole, orientByUnits(sc, p, UnitOrder::TwoThreads));
+  EXPECT_LT(wrongPercent(sc, whole), 15.0);
+}
+
+TEST(DacpoJob, OtherEdgeMeasuresWeighAllEdgesAtOnce)
+{
+  Scene sc(DACPO_SCENE_BOX_OPEN, 6000, 2);
+  ASSERT_TRUE(sc.ok);
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  p.num_blocks = 8;
+  for (dacpo_edge_weight w : {DACPO_WEIGHT_DIPOLE_BOUNDARY, DACPO_WEIGHT_OVERLAP}) {
+    p.edge_weight = w;
+    expectSameRun(orientScene(sc, p), orientByUnits(sc, p, UnitOrder::Reversed));
+  }
+}
+
+TEST(DacpoJob, BadArgumentsAreRejectedWithAMessage)
+{
+  Scene sc(DACPO_SCENE_BOX_OPEN, 2000, 1);
+  ASSERT_TRUE(sc.ok);
+  auto ctx = makeCtx();
+  dacpo_params p = defaults();
+  dacpo_job* job = reinterpret_cast<dacpo_job*>(&p); // must be overwritten
+  EXPECT_EQ(
+      dacpo_job_create(nullptr, &p, nullptr, nullptr, sc.s.xyz, nullptr, 2000, &job),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_job_create(
+                ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 2000, nullptr),
+            DACPO_ERR_INVALID_ARGUMENT);
+  // given axes expected (estimate_normals 0) but none given
+  EXPECT_EQ(
+      dacpo_job_create(ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 2000, &job),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(job, nullptr);
+  EXPECT_NE(std::string(dacpo_ctx_last_error(ctx.get())).find("estimate_normals"),
+            std::string::npos);
+  EXPECT_EQ(
+      dacpo_job_create(ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 0, &job),
+      DACPO_ERR_EMPTY_INPUT);
+  EXPECT_EQ(job, nullptr);
+
+  p.estimate_normals = 1;
+  ASSERT_EQ(
+      dacpo_job_create(ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 2000, &job),
+      DACPO_OK)
+      << dacpo_ctx_last_error(ctx.get());
+  JobPtr hold(job);
+  const size_t nb = dacpo_job_num_blocks(job), ne = dacpo_job_num_edges(job);
+  ASSERT_GT(nb, 0u);
+  char msg[128] = "unchanged";
+  EXPECT_EQ(dacpo_job_orient_block(job, nb, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("block"), std::string::npos) << msg;
+  EXPECT_EQ(dacpo_job_weigh_edge(job, ne, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("edge"), std::string::npos) << msg;
+  size_t a = 0, b = 0;
+  EXPECT_EQ(dacpo_job_edge_blocks(job, ne, &a, &b), DACPO_ERR_INVALID_ARGUMENT);
+  for (size_t e = 0; e < ne; ++e) {
+    ASSERT_EQ(dacpo_job_edge_blocks(job, e, &a, &b), DACPO_OK);
+    EXPECT_LT(a, nb);
+    EXPECT_LT(b, nb);
+    EXPECT_NE(a, b);
+  }
+  EXPECT_EQ(dacpo_job_orient_block(job, 0, msg, sizeof(msg)), DACPO_OK);
+  EXPECT_STREQ(msg, "");
+  EXPECT_EQ(dacpo_job_finish(job, nullptr), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_job_num_blocks(nullptr), 0u);
+  EXPECT_EQ(dacpo_job_solve(nullptr), DACPO_ERR_INVALID_ARGUMENT);
+  dacpo_job_free(nullptr);
 }
