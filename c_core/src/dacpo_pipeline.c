@@ -65,6 +65,10 @@ typedef struct run_state {
   double* part_conf;     /* per part */
   double global_sign;    /* +1 or -1: stage 6 */
   dacpo_ilp_result ilp;
+  /* what the work units have done (dacpo_advanced.h checks the order) */
+  uint8_t* block_done; /* per block: stages 2-3 */
+  uint8_t* edge_done;  /* per edge: stage 4 */
+  int solved, finished;
 } run_state;
 
 static void
@@ -94,6 +98,8 @@ run_state_free(run_state* s)
   free(s->part);
   free(s->part_sign);
   free(s->part_conf);
+  free(s->block_done);
+  free(s->edge_done);
 }
 
 /* Calls the progress callback; non-zero means the caller asked to stop. */
@@ -300,6 +306,7 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
   }
   if (s->ring_oriented)
     memcpy(s->ring_oriented + 3 * ring0, nrm + 3 * no, 3 * nr * sizeof(double));
+  s->block_done[b] = 1;
 done:
   (void)thread_id;
   free(xyz);
@@ -325,13 +332,15 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
   vp.perspective = s->p.vcr_perspective != 0;
   vp.boundary_factor = s->p.vcr_boundary_factor != 0;
   (void)thread_id;
-  return dacpo_vcr_edge(&s->meshes[edge->a],
-                        &s->meshes[edge->b],
-                        &vp,
-                        &edge->alpha,
-                        &edge->alpha_bar,
-                        NULL,
-                        err);
+  DACPO_TRY(dacpo_vcr_edge(&s->meshes[edge->a],
+                           &s->meshes[edge->b],
+                           &vp,
+                           &edge->alpha,
+                           &edge->alpha_bar,
+                           NULL,
+                           err));
+  s->edge_done[e] = 1;
+  return DACPO_OK;
 }
 
 /* ---- stage 5 ----------------------------------------------------------- */
@@ -905,8 +914,11 @@ alloc_block_results(run_state* s, dacpo_err* err)
   const int want_ring = s->p.edge_weight == DACPO_WEIGHT_OVERLAP;
   if (want_ring)
     s->ring_oriented = dacpo_malloc_array(3 * s->blocks.ring_start[nb], sizeof(double));
+  s->block_done = dacpo_calloc_array(nb + 1, 1);
+  s->edge_done = dacpo_calloc_array(s->bgraph.num_edges + 1, 1);
   if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
-      !s->cue_votes || (want_meshes && !s->meshes) || (want_ring && !s->ring_oriented))
+      !s->cue_votes || (want_meshes && !s->meshes) ||
+      (want_ring && !s->ring_oriented) || !s->block_done || !s->edge_done)
     return DACPO_OOM(err);
   return DACPO_OK;
 }
@@ -946,6 +958,7 @@ weigh_edges(run_state* s, dacpo_err* err)
   else
     DACPO_TRY(dacpo_block_graph_dipole_weights(
         &s->bgraph, &s->cloud, &s->adj, &s->blocks, s->oriented, s->p.dipole_c, err));
+  memset(s->edge_done, 1, s->bgraph.num_edges);
   return DACPO_OK;
 }
 
@@ -1109,6 +1122,38 @@ dacpo_job_edge_blocks(const dacpo_job* job, size_t e, size_t* a, size_t* b)
   return DACPO_OK;
 }
 
+/* The first of the n flags that is 0, or n. */
+static size_t
+first_missing(const uint8_t* done, size_t n)
+{
+  size_t i = 0;
+  while (i < n && done[i])
+    ++i;
+  return i;
+}
+
+/* Whether every block is oriented (and, with edges, every edge weighed);
+ * names the first that is not. */
+static dacpo_status
+job_units_done(const run_state* s, int edges, const char* step, dacpo_err* err)
+{
+  const size_t b = first_missing(s->block_done, s->blocks.num_blocks);
+  DACPO_CHECK(err,
+              b == s->blocks.num_blocks,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: %s before block %zu is oriented",
+              step,
+              b);
+  const size_t e = edges ? first_missing(s->edge_done, s->bgraph.num_edges) : 0;
+  DACPO_CHECK(err,
+              !edges || e == s->bgraph.num_edges,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: %s before edge %zu is weighed",
+              step,
+              e);
+  return DACPO_OK;
+}
+
 /* The message of a unit's failure into the caller's buffer. */
 static dacpo_status
 unit_result(const dacpo_err* err, char* msg, size_t msg_size)
@@ -1128,6 +1173,9 @@ dacpo_job_orient_block(dacpo_job* job, size_t b, char* msg, size_t msg_size)
                   "job: block %zu of %zu",
                   b,
                   dacpo_job_num_blocks(job));
+  else if (job->s.block_done[b])
+    dacpo_err_set(
+        &err, DACPO_ERR_INVALID_ARGUMENT, "job: block %zu is oriented already", b);
   else
     orient_block(&job->s, b, 0, &err);
   return unit_result(&err, msg, msg_size);
@@ -1147,6 +1195,14 @@ dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size)
     dacpo_err_set(&err,
                   DACPO_ERR_INVALID_ARGUMENT,
                   "job: edge by edge only with VCR weights; use dacpo_job_weigh_edges");
+  else if (!job->s.block_done[job->s.bgraph.edges[e].a] ||
+           !job->s.block_done[job->s.bgraph.edges[e].b])
+    dacpo_err_set(&err,
+                  DACPO_ERR_INVALID_ARGUMENT,
+                  "job: edge %zu before its blocks %d and %d are oriented",
+                  e,
+                  (int)job->s.bgraph.edges[e].a,
+                  (int)job->s.bgraph.edges[e].b);
   else
     weigh_edge_vcr(&job->s, e, 0, &err);
   return unit_result(&err, msg, msg_size);
@@ -1158,7 +1214,9 @@ dacpo_job_weigh_edges(dacpo_job* job)
   if (!job)
     return DACPO_ERR_INVALID_ARGUMENT;
   dacpo_err err = {DACPO_OK, {0}};
-  dacpo_status status = weigh_edges(&job->s, &err);
+  dacpo_status status = job_units_done(&job->s, 0, "weighing the edges", &err);
+  if (status == DACPO_OK)
+    status = weigh_edges(&job->s, &err);
   return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
 }
 
@@ -1168,6 +1226,10 @@ job_solve(dacpo_job* job, dacpo_err* err)
 {
   run_state* s = &job->s;
   dacpo_stats* st = &job->ctx->stats;
+  DACPO_TRY(job_units_done(s, 1, "the solve", err));
+  DACPO_CHECK(
+      err, !s->solved, DACPO_ERR_INVALID_ARGUMENT, "job: the flips are solved already");
+  s->solved = 1;
   st->ipsr_iterations_total = st->ipsr_iterations_max = 0;
   for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
     st->ipsr_iterations_total += s->ipsr[b].iterations;
@@ -1199,6 +1261,12 @@ dacpo_job_solve(dacpo_job* job)
 static dacpo_status
 job_finish(dacpo_job* job, float* normals, dacpo_err* err)
 {
+  DACPO_CHECK(err,
+              job->s.solved && !job->s.finished,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: finish %s",
+              job->s.finished ? "was called already" : "before the solve");
+  job->s.finished = 1;
   if (job->s.p.keep_mesh) {
     DACPO_TRY(build_scene_mesh(&job->s, err));
     DACPO_TRY(stage_done(job, DACPO_STAGE_MESH, err));

@@ -969,6 +969,7 @@ TEST(DacpoJob, BadArgumentsAreRejectedWithAMessage)
   EXPECT_EQ(job, nullptr);
 
   p.estimate_normals = 1;
+  p.num_blocks = 6;
   ASSERT_EQ(
       dacpo_job_create(ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 2000, &job),
       DACPO_OK)
@@ -993,7 +994,33 @@ TEST(DacpoJob, BadArgumentsAreRejectedWithAMessage)
   }
   EXPECT_EQ(dacpo_job_orient_block(job, 0, msg, sizeof(msg)), DACPO_OK);
   EXPECT_STREQ(msg, "");
+  // out of order: a block twice, an edge before its blocks, the solve or the
+  // finish too early
+  EXPECT_EQ(dacpo_job_orient_block(job, 0, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("already"), std::string::npos) << msg;
+  ASSERT_GT(ne, 0u);
+  EXPECT_EQ(dacpo_job_weigh_edge(job, 0, msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("before its blocks"), std::string::npos) << msg;
+  EXPECT_EQ(dacpo_job_solve(job), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(dacpo_ctx_last_error(ctx.get())).find("before block 1"),
+            std::string::npos)
+      << dacpo_ctx_last_error(ctx.get());
+  std::vector<float> out(3 * 2000);
+  EXPECT_EQ(dacpo_job_finish(job, out.data()), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(dacpo_ctx_last_error(ctx.get())).find("before the solve"),
+            std::string::npos);
   EXPECT_EQ(dacpo_job_finish(job, nullptr), DACPO_ERR_INVALID_ARGUMENT);
+  // in order from here on, the job completes
+  for (size_t i = 1; i < nb; ++i)
+    ASSERT_EQ(dacpo_job_orient_block(job, i, msg, sizeof(msg)), DACPO_OK) << msg;
+  for (size_t e = 0; e < ne; ++e)
+    ASSERT_EQ(dacpo_job_weigh_edge(job, e, msg, sizeof(msg)), DACPO_OK) << msg;
+  ASSERT_EQ(dacpo_job_solve(job), DACPO_OK) << dacpo_ctx_last_error(ctx.get());
+  EXPECT_EQ(dacpo_job_solve(job), DACPO_ERR_INVALID_ARGUMENT);
+  ASSERT_EQ(dacpo_job_finish(job, out.data()), DACPO_OK)
+      << dacpo_ctx_last_error(ctx.get());
+  EXPECT_EQ(dacpo_job_finish(job, out.data()), DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_job_num_blocks(nullptr), 0u);
   EXPECT_EQ(dacpo_job_solve(nullptr), DACPO_ERR_INVALID_ARGUMENT);
   dacpo_job_free(nullptr);
