@@ -419,6 +419,45 @@ TEST(DacpoScene, TwoRoomsShareAWallWithADoor)
   EXPECT_GT(door_floor, 0u); // the floor continues through the door
 }
 
+// The building's geometry, face by face: walls between a room and the corridor
+// are sampled on both sides (normals into the room / the corridor), no point
+// stands in a door, the floor runs on through every door.
+TEST(DacpoScene, BuildingRoomsOpenOntoTheCorridor)
+{
+  Scene sc(DACPO_SCENE_BUILDING, 200000, 2);
+  ASSERT_EQ(sc.s.num_objects, 7u); // six rooms and the corridor
+  const double W = 4.0, T = 0.1, C = 2.0;
+  size_t corridor_face = 0, room_face = 0, door_floor = 0;
+  for (size_t i = 0; i < sc.s.n; ++i) {
+    const float* p = sc.p(i);
+    const float* n = sc.n(i);
+    ASSERT_GE(p[2], 0.0f);
+    ASSERT_LE(p[2], 2.6f + 1e-5f);
+    ASSERT_TRUE(p[0] >= T - 1e-5 && p[0] <= 3 * (W + T) + 1e-5) << p[0];
+    if (std::fabs(p[1] - C) < 1e-5 && n[1] != 0.0f) { // corridor side, north slab
+      ++corridor_face;
+      ASSERT_FLOAT_EQ(n[1], -1.0f);
+    }
+    if (std::fabs(p[1] - (C + T)) < 1e-5 && n[1] != 0.0f) { // room side
+      ++room_face;
+      ASSERT_FLOAT_EQ(n[1], 1.0f);
+    }
+    // Doors: x in [i (W + T) + T + 1.55, ... + 2.45], z < 2: empty across both slabs.
+    for (int r = 0; r < 3; ++r) {
+      const double d0 = r * (W + T) + T + 0.5 * W - 0.45;
+      const bool in_door = p[0] > d0 + 1e-4 && p[0] < d0 + 0.9 - 1e-4 && p[2] > 1e-4 &&
+                           p[2] < 2.0 - 1e-4;
+      const bool in_slab = (p[1] > C + 1e-4 && p[1] < C + T - 1e-4) ||
+                           (p[1] > -T + 1e-4 && p[1] < -1e-4);
+      ASSERT_FALSE(in_door && in_slab) << "point in a door at " << p[0] << ", " << p[1];
+      door_floor += in_slab && p[2] == 0.0f && p[0] > d0 && p[0] < d0 + 0.9;
+    }
+  }
+  EXPECT_GT(corridor_face, 500u);
+  EXPECT_NEAR(double(corridor_face), double(room_face), 0.15 * room_face);
+  EXPECT_GT(door_floor, 0u);
+}
+
 TEST(DacpoScene, MillionPointsAreFast)
 {
   Scene sc(DACPO_SCENE_ROOM, 1000000, 1, 0.004, 500000);

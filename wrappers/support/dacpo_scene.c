@@ -630,6 +630,72 @@ scene_partition(scene_builder* b)
   add_box(b, 1.99, 0.5, 0.0, 2.01, 2.5, 1.8, FACE_NZ);
 }
 
+/* One floor of a building (multi-room known answer for scale-out): a 2 m
+ * corridor along x (y in [0, 2]) between BUILDING_ROOMS rooms on each side,
+ * 4 x 3.5 m each, walls 10 cm thick and 2.6 m high, no ceiling. Every room has
+ * a 0.9 x 2.0 m door to the corridor in the middle of its front wall. Sampled,
+ * as a scanner walking through would see them: floors, the inner faces of the
+ * rooms and of the corridor, both faces of the walls between rooms and between
+ * rooms and corridor (each face normal into the space it faces), the tops of
+ * those inner walls, the doors' jambs, lintels and the floor under them. The
+ * outer walls are one-sided (their outsides and tops are never seen). */
+#define BUILDING_ROOMS 3
+
+static void
+building_room(scene_builder* b, int north, int i)
+{
+  static const char* const names[2][BUILDING_ROOMS] = {
+      {"room_s1", "room_s2", "room_s3"}, {"room_n1", "room_n2", "room_n3"}};
+  const double W = 4.0, D = 3.5, C = 2.0, T = 0.1, H = 2.6;
+  const double door0 = 0.5 * W - 0.45, door1 = 0.5 * W + 0.45, door_h = 2.0;
+  const double x0 = T + i * (W + T), x1 = x0 + W;
+  /* interior y0..y1; the front wall slab lies between the room and y in [0, C] */
+  const double y0 = north ? C + T : -T - D, y1 = y0 + D;
+  const double front = north ? y0 : y1,
+               slab = north ? C : 0.0;  /* slab: [C, C+T] or [-T, 0] */
+  const double ny = north ? 1.0 : -1.0; /* from the front wall into the room */
+  begin_object(b, names[north][i]);
+  quad(b, x0, y0, 0, W, 0, 0, 0, D, 0, 0, 0, 1);
+  quad(b, x0, y0, 0, 0, D, 0, 0, 0, H, 1, 0, 0);
+  quad(b, x1, y0, 0, 0, D, 0, 0, 0, H, -1, 0, 0);
+  quad(b, x0, north ? y1 : y0, 0, W, 0, 0, 0, 0, H, 0, -ny, 0);
+  scene_prim* face = quad(b, x0, front, 0, W, 0, 0, 0, 0, H, 0, ny, 0);
+  add_hole(b, face, door0, door1, 0.0, door_h);
+  /* the door through the front slab y in [slab, slab + T] */
+  const double sy = north ? slab : -T;
+  quad(b, x0 + door0, sy, 0, 0, T, 0, 0, 0, door_h, 1, 0, 0);
+  quad(b, x0 + door1, sy, 0, 0, T, 0, 0, 0, door_h, -1, 0, 0);
+  quad(b, x0 + door0, sy, door_h, door1 - door0, 0, 0, 0, T, 0, 0, 0, -1);
+  quad(b, x0 + door0, sy, 0, door1 - door0, 0, 0, 0, T, 0, 0, 0, 1);
+  /* top of the front slab along this room; the wall to the next room (slab
+   * x in [x1, x1 + T], through to the corridor) and its top */
+  quad(b, x0, sy, H, W, 0, 0, 0, T, 0, 0, 0, 1);
+  if (i + 1 < BUILDING_ROOMS)
+    quad(b, x1, north ? C : y0, H, T, 0, 0, 0, D + T, 0, 0, 0, 1);
+}
+
+static void
+scene_building(scene_builder* b)
+{
+  const double W = 4.0, C = 2.0, T = 0.1, H = 2.6;
+  const double L = BUILDING_ROOMS * (W + T) + T; /* outer x extent */
+  for (int north = 0; north < 2; ++north)
+    for (int i = 0; i < BUILDING_ROOMS; ++i)
+      building_room(b, north, i);
+  begin_object(b, "corridor");
+  quad(b, T, 0, 0, L - 2 * T, 0, 0, 0, C, 0, 0, 0, 1);
+  quad(b, T, 0, 0, 0, C, 0, 0, 0, H, 1, 0, 0);
+  quad(b, L - T, 0, 0, 0, C, 0, 0, 0, H, -1, 0, 0);
+  /* the corridor faces of the front slabs, one door per room */
+  scene_prim* south = quad(b, T, 0, 0, L - 2 * T, 0, 0, 0, 0, H, 0, 1, 0);
+  scene_prim* north = quad(b, T, C, 0, L - 2 * T, 0, 0, 0, 0, H, 0, -1, 0);
+  for (int i = 0; i < BUILDING_ROOMS; ++i) {
+    const double d0 = i * (W + T) + 0.5 * W - 0.45;
+    add_hole(b, south, d0, d0 + 0.9, 0.0, 2.0);
+    add_hole(b, north, d0, d0 + 0.9, 0.0, 2.0);
+  }
+}
+
 typedef struct scene_entry {
   const char* name;
   void (*build)(scene_builder*);
@@ -647,6 +713,7 @@ static const scene_entry scene_table[DACPO_SCENE_KIND_COUNT] = {
     {"table", scene_table_on_floor},
     {"tube", scene_tube},
     {"partition", scene_partition},
+    {"building", scene_building},
 };
 
 /* ------------------------------------------------------------------------- */

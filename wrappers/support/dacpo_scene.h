@@ -69,7 +69,13 @@ typedef enum dacpo_scene_kind {
   /** 2 cm partition (2 x 1.8 m, both faces, top, ends) standing on a 4 x 3 m
    *  floor midway between two walls that face each other. */
   DACPO_SCENE_PARTITION = 10,
-  DACPO_SCENE_KIND_COUNT = 11
+  /** One floor of a building, 12.4 x 9.2 m: a 2 m corridor along x between
+   *  three 4 x 3.5 m rooms on each side, 10 cm walls 2.6 m high, no ceiling;
+   *  a 0.9 x 2 m door from every room to the corridor. Both faces of the inner
+   *  walls, their tops, the door jambs, lintels and floor strips are sampled;
+   *  the outer walls only from inside. For scale-out runs. */
+  DACPO_SCENE_BUILDING = 11,
+  DACPO_SCENE_KIND_COUNT = 12
 } dacpo_scene_kind;
 
 /** \brief Room scene dimensions (DACPO_SCENE_ROOM), metres. */
