@@ -11,6 +11,7 @@
 #include <dacpo/dacpo_advanced.h>
 
 #include "dacpo_block_graph.h"
+#include "dacpo_block_unit.h"
 #include "dacpo_bridge.h"
 #include "dacpo_context.h"
 #include "dacpo_dipole.h"
@@ -30,10 +31,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Blocks smaller than this are too small for a Poisson solve; they keep the
- * dipole orientation (stage 2). */
-#define DACPO_MIN_IPSR_POINTS 32
 
 typedef struct run_state {
   dacpo_params p;
@@ -209,112 +206,80 @@ estimate_normals(run_state* s, dacpo_err* err)
 
 /* ---- stages 2-3: one block at a time ----------------------------------- */
 
-/* Stage 2's parameters for block b (its own random stream); thin: the block's
- * thin-part flags (output). */
-static dacpo_dipole_params
-block_dipole_params(const run_state* s, size_t b, uint8_t* thin)
+/* Block b's points, own first, then its ring (the ring gives continuity to
+ * propagation and Poisson but is not part of the output). */
+static void
+gather_block(const run_state* s, size_t b, double* xyz, double* axes)
 {
-  dacpo_dipole_params dp;
-  dp.c = s->p.dipole_c;
-  dp.orders = s->p.dipole_orders;
-  dp.neighbors = s->p.dipole_neighbors;
-  dp.graph_k = s->p.k;
-  dp.final_sweep = s->p.dipole_final_sweep;
-  dp.seed = s->p.seed;
-  dp.stream = (uint64_t)b;
-  dp.noise_band = s->p.dipole_noise_band;
-  dp.two_sheet = s->p.dipole_two_sheet;
-  dp.layers = s->p.dipole_layers;
-  dp.c_thin = s->p.dipole_c_thin;
-  dp.restarts = s->p.dipole_restarts;
-  dp.restart_vote = s->p.dipole_restart_vote;
-  dp.sides = s->p.dipole_sides;
-  dp.thin_out = thin;
-  dp.cue_out = NULL;
-  return dp;
+  const dacpo_blocks* bl = &s->blocks;
+  const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
+  const size_t ring0 = bl->ring_start[b], nr = bl->ring_start[b + 1] - ring0;
+  for (size_t i = 0; i < no + nr; ++i) {
+    int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
+    memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
+    memcpy(axes + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
+  }
+}
+
+static size_t
+block_own(const run_state* s, size_t b)
+{
+  return s->blocks.own_start[b + 1] - s->blocks.own_start[b];
+}
+
+static size_t
+block_size(const run_state* s, size_t b)
+{
+  return block_own(s, b) + s->blocks.ring_start[b + 1] - s->blocks.ring_start[b];
+}
+
+/* Block b's results into the run; its mesh moves into the run. */
+static void
+store_block(run_state* s, size_t b, dacpo_block_out* out)
+{
+  const dacpo_blocks* bl = &s->blocks;
+  const size_t own0 = bl->own_start[b], no = block_own(s, b);
+  const size_t ring0 = bl->ring_start[b], nr = block_size(s, b) - no;
+  for (size_t i = 0; i < no; ++i) {
+    const size_t q = (size_t)bl->own[own0 + i];
+    memcpy(s->oriented + 3 * q, out->nrm + 3 * i, 3 * sizeof(double));
+    s->point_conf[q] = out->conf[i];
+  }
+  if (s->ring_oriented)
+    memcpy(s->ring_oriented + 3 * ring0, out->nrm + 3 * no, 3 * nr * sizeof(double));
+  s->cue_votes[2 * b] = out->cue_votes[0];
+  s->cue_votes[2 * b + 1] = out->cue_votes[1];
+  s->block_seconds[2 * b] = out->seconds[0];
+  s->block_seconds[2 * b + 1] = out->seconds[1];
+  s->ipsr[b] = out->ipsr;
+  if (s->meshes) {
+    s->meshes[b] = out->mesh;
+    memset(&out->mesh, 0, sizeof(out->mesh));
+  }
+  s->block_done[b] = 1;
 }
 
 static dacpo_status
 orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
 {
   run_state* s = user;
-  const dacpo_blocks* bl = &s->blocks;
-  const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
-  const size_t ring0 = bl->ring_start[b], nr = bl->ring_start[b + 1] - ring0;
-  const size_t n = no + nr;
+  const size_t n = block_size(s, b);
   double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
-  double* nrm = dacpo_malloc_array(3 * n, sizeof(double));
-  int8_t* sign = dacpo_malloc_array(n, sizeof(int8_t));
-  float* conf = dacpo_malloc_array(n, sizeof(float));
-  uint8_t* thin = dacpo_malloc_array(n, sizeof(uint8_t));
-  int8_t* cue = dacpo_malloc_array(n, sizeof(int8_t));
-  dacpo_status st = DACPO_OK;
-  if (!xyz || !nrm || !sign || !conf || !thin || !cue) {
-    st = DACPO_OOM(err);
-    goto done;
+  double* axes = dacpo_malloc_array(3 * n, sizeof(double));
+  dacpo_block_out out;
+  memset(&out, 0, sizeof(out));
+  dacpo_status st = xyz && axes ? DACPO_OK : DACPO_OOM(err);
+  if (st == DACPO_OK) {
+    gather_block(s, b, xyz, axes);
+    st = dacpo_block_unit_run(
+        &s->p, b, xyz, axes, n, block_own(s, b), s->meshes != NULL, &out, err);
   }
-  /* own points first, then the ring (the ring gives
-   * continuity to propagation and Poisson but is not part of the output) */
-  for (size_t i = 0; i < n; ++i) {
-    int32_t q = i < no ? bl->own[own0 + i] : bl->ring[ring0 + (i - no)];
-    memcpy(xyz + 3 * i, s->cloud.xyz + 3 * (size_t)q, 3 * sizeof(double));
-    memcpy(nrm + 3 * i, s->cloud.nrm + 3 * (size_t)q, 3 * sizeof(double));
-  }
-  dacpo_dipole_params dp = block_dipole_params(s, b, thin);
-  dp.cue_out = cue;
-  double t0 = dacpo_now();
-  st = dacpo_dipole_orient_confidence(xyz, nrm, n, &dp, sign, conf, err);
-  double t1 = dacpo_now();
-  /* the cue's points keep their stage-2 sign through stage 3 (ip.fixed) */
-  for (size_t i = 0; st == DACPO_OK && i < no; ++i)
-    if (cue[i])
-      s->cue_votes[2 * b + (cue[i] > 0 ? 0 : 1)]++;
-  s->block_seconds[2 * b] = t1 - t0;
-  if (st != DACPO_OK)
-    goto done;
-  for (size_t i = 0; i < n; ++i)
-    for (int d = 0; d < 3; ++d)
-      nrm[3 * i + d] *= (double)sign[i];
-
-  /* With iPSR off but VCR weights on, one Poisson solve still gives the block
-   * its mesh (0 iterations: the normals are not changed). */
-  if ((s->p.ipsr_enabled || s->meshes) && n >= DACPO_MIN_IPSR_POINTS) {
-    dacpo_ipsr_params ip;
-    dacpo_ipsr_params_default(&ip);
-    ip.max_iterations = s->p.ipsr_enabled ? s->p.ipsr_max_iterations : 0;
-    /* Stage 3 cannot see parts thinner than its grid: on a board 0.3-1
-     * spacing thick its indicator function merges the two faces and turns one
-     * over (two clean sheets half a spacing apart: 0 % wrong after stage 2,
-     * 50 % after stage 3). Points where the stage-2 side cue fired keep their
-     * stage-2 normal through the iterations. */
-    ip.fixed = thin;
-    st = dacpo_ipsr_block(
-        xyz, nrm, n, no, &ip, s->meshes ? &s->meshes[b] : NULL, &s->ipsr[b], err);
-    s->block_seconds[2 * b + 1] = dacpo_now() - t1;
-    if (st != DACPO_OK)
-      goto done;
-  }
-  for (size_t i = 0; i < no; ++i) {
-    const size_t q = (size_t)bl->own[own0 + i];
-    memcpy(s->oriented + 3 * q, nrm + 3 * i, 3 * sizeof(double));
-    /* nrm started as sign * axis: a negative dot means stage 3 turned it over */
-    const double* a = s->cloud.nrm + 3 * q;
-    const double d =
-        (a[0] * nrm[3 * i] + a[1] * nrm[3 * i + 1] + a[2] * nrm[3 * i + 2]) *
-        (double)sign[i];
-    s->point_conf[q] = d >= 0.0 ? conf[i] : 0.5f * conf[i];
-  }
-  if (s->ring_oriented)
-    memcpy(s->ring_oriented + 3 * ring0, nrm + 3 * no, 3 * nr * sizeof(double));
-  s->block_done[b] = 1;
-done:
+  if (st == DACPO_OK)
+    store_block(s, b, &out);
   (void)thread_id;
   free(xyz);
-  free(nrm);
-  free(sign);
-  free(conf);
-  free(thin);
-  free(cue);
+  free(axes);
+  dacpo_block_out_free(&out);
   return st;
 }
 
@@ -326,11 +291,7 @@ weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
   run_state* s = user;
   dacpo_block_edge* edge = &s->bgraph.edges[e];
   dacpo_vcr_params vp;
-  dacpo_vcr_params_default(&vp);
-  vp.image_size = s->p.vcr_image_size;
-  vp.num_views = s->p.vcr_views;
-  vp.perspective = s->p.vcr_perspective != 0;
-  vp.boundary_factor = s->p.vcr_boundary_factor != 0;
+  dacpo_block_unit_vcr_params(&s->p, &vp);
   (void)thread_id;
   DACPO_TRY(dacpo_vcr_edge(&s->meshes[edge->a],
                            &s->meshes[edge->b],
@@ -1154,60 +1115,6 @@ job_units_done(const run_state* s, int edges, const char* step, dacpo_err* err)
   return DACPO_OK;
 }
 
-/* The message of a unit's failure into the caller's buffer. */
-static dacpo_status
-unit_result(const dacpo_err* err, char* msg, size_t msg_size)
-{
-  if (msg && msg_size > 0)
-    snprintf(msg, msg_size, "%s", err->code != DACPO_OK ? err->msg : "");
-  return err->code;
-}
-
-dacpo_status
-dacpo_job_orient_block(dacpo_job* job, size_t b, char* msg, size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (!job || b >= job->s.blocks.num_blocks)
-    dacpo_err_set(&err,
-                  DACPO_ERR_INVALID_ARGUMENT,
-                  "job: block %zu of %zu",
-                  b,
-                  dacpo_job_num_blocks(job));
-  else if (job->s.block_done[b])
-    dacpo_err_set(
-        &err, DACPO_ERR_INVALID_ARGUMENT, "job: block %zu is oriented already", b);
-  else
-    orient_block(&job->s, b, 0, &err);
-  return unit_result(&err, msg, msg_size);
-}
-
-dacpo_status
-dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (!job || e >= job->s.bgraph.num_edges)
-    dacpo_err_set(&err,
-                  DACPO_ERR_INVALID_ARGUMENT,
-                  "job: edge %zu of %zu",
-                  e,
-                  dacpo_job_num_edges(job));
-  else if (job->s.p.edge_weight != DACPO_WEIGHT_VCR)
-    dacpo_err_set(&err,
-                  DACPO_ERR_INVALID_ARGUMENT,
-                  "job: edge by edge only with VCR weights; use dacpo_job_weigh_edges");
-  else if (!job->s.block_done[job->s.bgraph.edges[e].a] ||
-           !job->s.block_done[job->s.bgraph.edges[e].b])
-    dacpo_err_set(&err,
-                  DACPO_ERR_INVALID_ARGUMENT,
-                  "job: edge %zu before its blocks %d and %d are oriented",
-                  e,
-                  (int)job->s.bgraph.edges[e].a,
-                  (int)job->s.bgraph.edges[e].b);
-  else
-    weigh_edge_vcr(&job->s, e, 0, &err);
-  return unit_result(&err, msg, msg_size);
-}
-
 dacpo_status
 dacpo_job_weigh_edges(dacpo_job* job)
 {
@@ -1218,6 +1125,209 @@ dacpo_job_weigh_edges(dacpo_job* job)
   if (status == DACPO_OK)
     status = weigh_edges(&job->s, &err);
   return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
+}
+
+/* ---- units for another process (dacpo_advanced.h) ------------------------ */
+
+/* Whether block b may take a result: a valid id, not yet oriented. */
+static dacpo_status
+block_open(const dacpo_job* job, size_t b, dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              job && b < job->s.blocks.num_blocks,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: block %zu of %zu",
+              b,
+              dacpo_job_num_blocks(job));
+  DACPO_CHECK(err,
+              !job->s.block_done[b],
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: block %zu is oriented already",
+              b);
+  return DACPO_OK;
+}
+
+static dacpo_status
+job_block_task(
+    const dacpo_job* job, size_t b, void** bytes, size_t* size, dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              job && b < job->s.blocks.num_blocks,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: block %zu of %zu",
+              b,
+              dacpo_job_num_blocks(job));
+  const run_state* s = &job->s;
+  const size_t n = block_size(s, b);
+  double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
+  double* axes = dacpo_malloc_array(3 * n, sizeof(double));
+  dacpo_status st = xyz && axes ? DACPO_OK : DACPO_OOM(err);
+  if (st == DACPO_OK) {
+    gather_block(s, b, xyz, axes);
+    st = dacpo_block_task_pack(
+        &s->p, b, xyz, axes, n, block_own(s, b), s->meshes != NULL, bytes, size, err);
+  }
+  free(xyz);
+  free(axes);
+  return st;
+}
+
+dacpo_status
+dacpo_job_block_task(const dacpo_job* job,
+                     size_t b,
+                     void** bytes,
+                     size_t* size,
+                     char* msg,
+                     size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (!bytes || !size)
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: bytes or size is NULL");
+  else {
+    *bytes = NULL;
+    *size = 0;
+    job_block_task(job, b, bytes, size, &err);
+  }
+  return dacpo_unit_message(&err, msg, msg_size);
+}
+
+static dacpo_status
+job_put_block(dacpo_job* job, const void* bytes, size_t size, dacpo_err* err)
+{
+  DACPO_CHECK(err, job != NULL, DACPO_ERR_INVALID_ARGUMENT, "job: job is NULL");
+  dacpo_block_out out;
+  size_t b, n, no;
+  int has_mesh;
+  DACPO_TRY(dacpo_block_result_unpack(bytes, size, &b, &n, &no, &has_mesh, &out, err));
+  dacpo_status st = block_open(job, b, err);
+  if (st == DACPO_OK && (n != block_size(&job->s, b) || no != block_own(&job->s, b) ||
+                         has_mesh != (job->s.meshes != NULL)))
+    st = dacpo_err_set(err,
+                       DACPO_ERR_INVALID_ARGUMENT,
+                       "job: the result for block %zu holds %zu points (%zu own, mesh "
+                       "%d), the block %zu (%zu own, mesh %d)",
+                       b,
+                       n,
+                       no,
+                       has_mesh,
+                       block_size(&job->s, b),
+                       block_own(&job->s, b),
+                       job->s.meshes != NULL);
+  if (st == DACPO_OK)
+    store_block(&job->s, b, &out);
+  dacpo_block_out_free(&out);
+  return st;
+}
+
+dacpo_status
+dacpo_job_put_block(
+    dacpo_job* job, const void* bytes, size_t size, char* msg, size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  job_put_block(job, bytes, size, &err);
+  return dacpo_unit_message(&err, msg, msg_size);
+}
+
+/* Whether edge e can be weighed by VCR now: a valid id, VCR weights, both
+ * blocks oriented. */
+static dacpo_status
+edge_ready(const dacpo_job* job, size_t e, dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              job && e < job->s.bgraph.num_edges,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: edge %zu of %zu",
+              e,
+              dacpo_job_num_edges(job));
+  DACPO_CHECK(err,
+              job->s.p.edge_weight == DACPO_WEIGHT_VCR,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: edge by edge only with VCR weights; use dacpo_job_weigh_edges");
+  const dacpo_block_edge* edge = &job->s.bgraph.edges[e];
+  DACPO_CHECK(err,
+              job->s.block_done[edge->a] && job->s.block_done[edge->b],
+              DACPO_ERR_INVALID_ARGUMENT,
+              "job: edge %zu before its blocks %d and %d are oriented",
+              e,
+              (int)edge->a,
+              (int)edge->b);
+  return DACPO_OK;
+}
+
+dacpo_status
+dacpo_job_edge_task(const dacpo_job* job,
+                    size_t e,
+                    void** bytes,
+                    size_t* size,
+                    char* msg,
+                    size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (!bytes || !size)
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: bytes or size is NULL");
+  else {
+    *bytes = NULL;
+    *size = 0;
+    if (edge_ready(job, e, &err) == DACPO_OK) {
+      const dacpo_block_edge* edge = &job->s.bgraph.edges[e];
+      dacpo_edge_task_pack(&job->s.p,
+                           e,
+                           &job->s.meshes[edge->a],
+                           &job->s.meshes[edge->b],
+                           bytes,
+                           size,
+                           &err);
+    }
+  }
+  return dacpo_unit_message(&err, msg, msg_size);
+}
+
+dacpo_status
+dacpo_job_put_edge(dacpo_job* job,
+                   size_t e,
+                   double alpha,
+                   double alpha_bar,
+                   char* msg,
+                   size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (edge_ready(job, e, &err) == DACPO_OK) {
+    if (job->s.edge_done[e])
+      dacpo_err_set(
+          &err, DACPO_ERR_INVALID_ARGUMENT, "job: edge %zu is weighed already", e);
+    else if (!(alpha >= 0.0 && alpha_bar >= 0.0 && isfinite(alpha) &&
+               isfinite(alpha_bar)))
+      dacpo_err_set(&err,
+                    DACPO_ERR_INVALID_ARGUMENT,
+                    "job: edge %zu: alpha %g and alpha_bar %g must be finite and >= 0",
+                    e,
+                    alpha,
+                    alpha_bar);
+    else {
+      job->s.bgraph.edges[e].alpha = alpha;
+      job->s.bgraph.edges[e].alpha_bar = alpha_bar;
+      job->s.edge_done[e] = 1;
+    }
+  }
+  return dacpo_unit_message(&err, msg, msg_size);
+}
+
+dacpo_status
+dacpo_job_orient_block(dacpo_job* job, size_t b, char* msg, size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (block_open(job, b, &err) == DACPO_OK)
+    orient_block(&job->s, b, 0, &err);
+  return dacpo_unit_message(&err, msg, msg_size);
+}
+
+dacpo_status
+dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size)
+{
+  dacpo_err err = {DACPO_OK, {0}};
+  if (edge_ready(job, e, &err) == DACPO_OK)
+    weigh_edge_vcr(&job->s, e, 0, &err);
+  return dacpo_unit_message(&err, msg, msg_size);
 }
 
 /* Stages 5-6 and the parts. */

@@ -851,10 +851,48 @@ struct JobDeleter {
 };
 using JobPtr = std::unique_ptr<dacpo_job, JobDeleter>;
 
-enum class UnitOrder { Reversed, TwoThreads };
+struct UnitBytes {
+  void* p = nullptr;
+  size_t size = 0;
+  ~UnitBytes() { dacpo_unit_bytes_free(p); }
+};
 
-// dacpo_orient()'s steps called one by one: blocks and edges last to first, or
-// split between two threads (even and odd ids).
+// Block b as another process runs it: task bytes out, result bytes back.
+dacpo_status
+blockAsBytes(dacpo_job* job, size_t b)
+{
+  char msg[256];
+  UnitBytes task, result;
+  dacpo_status st = dacpo_job_block_task(job, b, &task.p, &task.size, msg, sizeof(msg));
+  if (st == DACPO_OK)
+    st = dacpo_block_task_run(
+        task.p, task.size, &result.p, &result.size, msg, sizeof(msg));
+  if (st == DACPO_OK)
+    st = dacpo_job_put_block(job, result.p, result.size, msg, sizeof(msg));
+  EXPECT_EQ(st, DACPO_OK) << msg;
+  return st;
+}
+
+dacpo_status
+edgeAsBytes(dacpo_job* job, size_t e)
+{
+  char msg[256];
+  UnitBytes task;
+  double alpha = -1.0, alpha_bar = -1.0;
+  dacpo_status st = dacpo_job_edge_task(job, e, &task.p, &task.size, msg, sizeof(msg));
+  if (st == DACPO_OK)
+    st = dacpo_edge_task_run(task.p, task.size, &alpha, &alpha_bar, msg, sizeof(msg));
+  if (st == DACPO_OK)
+    st = dacpo_job_put_edge(job, e, alpha, alpha_bar, msg, sizeof(msg));
+  EXPECT_EQ(st, DACPO_OK) << msg;
+  return st;
+}
+
+enum class UnitOrder { Reversed, TwoThreads, AsBytes };
+
+// dacpo_orient()'s steps called one by one: blocks and edges last to first,
+// split between two threads (even and odd ids), or last to first as bytes
+// (task -> run without the job -> put), as another process would run them.
 Result
 orientByUnits(const Scene& sc, const dacpo_params& p, UnitOrder order)
 {
@@ -891,11 +929,15 @@ orientByUnits(const Scene& sc, const dacpo_params& p, UnitOrder order)
   };
   char msg[256];
   r.status = run_units(dacpo_job_num_blocks(job.get()), [&](size_t b) {
-    return dacpo_job_orient_block(job.get(), b, nullptr, 0);
+    return order == UnitOrder::AsBytes
+               ? blockAsBytes(job.get(), b)
+               : dacpo_job_orient_block(job.get(), b, nullptr, 0);
   });
   if (r.status == DACPO_OK && p.edge_weight == DACPO_WEIGHT_VCR)
     r.status = run_units(dacpo_job_num_edges(job.get()), [&](size_t e) {
-      return dacpo_job_weigh_edge(job.get(), e, nullptr, 0);
+      return order == UnitOrder::AsBytes
+                 ? edgeAsBytes(job.get(), e)
+                 : dacpo_job_weigh_edge(job.get(), e, nullptr, 0);
     });
   else if (r.status == DACPO_OK) {
     // edge by edge is for VCR only; the other measures weigh all edges at once
@@ -927,6 +969,7 @@ TEST(DacpoJob, UnitsInAnyOrderGiveTheAnswerOfOrient)
   ASSERT_GT(whole.stats.num_block_edges, 10u);
   expectSameRun(whole, orientByUnits(sc, p, UnitOrder::Reversed));
   expectSameRun(whole, orientByUnits(sc, p, UnitOrder::TwoThreads));
+  expectSameRun(whole, orientByUnits(sc, p, UnitOrder::AsBytes));
   EXPECT_LT(wrongPercent(sc, whole), 15.0);
 }
 
@@ -941,6 +984,114 @@ TEST(DacpoJob, OtherEdgeMeasuresWeighAllEdgesAtOnce)
     p.edge_weight = w;
     expectSameRun(orientScene(sc, p), orientByUnits(sc, p, UnitOrder::Reversed));
   }
+  // blocks as bytes carry their ring normals (overlap weights) and no mesh
+  p.edge_weight = DACPO_WEIGHT_OVERLAP;
+  expectSameRun(orientScene(sc, p), orientByUnits(sc, p, UnitOrder::AsBytes));
+}
+
+// A message that is cut short, altered, for another block or sent twice is
+// refused with a message; the job stays usable and completes.
+TEST(DacpoJob, UnitBytesAreCheckedBeforeUse)
+{
+  Scene sc(DACPO_SCENE_BOX_OPEN, 3000, 1);
+  ASSERT_TRUE(sc.ok);
+  auto ctx = makeCtx();
+  dacpo_params p = defaults();
+  p.estimate_normals = 1;
+  p.num_blocks = 4;
+  dacpo_job* raw = nullptr;
+  ASSERT_EQ(
+      dacpo_job_create(ctx.get(), &p, nullptr, nullptr, sc.s.xyz, nullptr, 3000, &raw),
+      DACPO_OK);
+  JobPtr job(raw);
+  ASSERT_GE(dacpo_job_num_blocks(raw), 2u);
+  char msg[256];
+  UnitBytes task, result, other;
+  ASSERT_EQ(dacpo_job_block_task(raw, 0, &task.p, &task.size, msg, sizeof(msg)),
+            DACPO_OK);
+  EXPECT_EQ(dacpo_job_block_task(raw, 99, &other.p, &other.size, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(other.p, nullptr);
+  // a task cut short or with another magic is not run
+  void* out = nullptr;
+  size_t out_size = 0;
+  EXPECT_EQ(
+      dacpo_block_task_run(task.p, task.size - 8, &out, &out_size, msg, sizeof(msg)),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("bytes"), std::string::npos) << msg;
+  EXPECT_EQ(out, nullptr);
+  std::vector<unsigned char> bad(static_cast<unsigned char*>(task.p),
+                                 static_cast<unsigned char*>(task.p) + task.size);
+  bad[0] ^= 0xff;
+  EXPECT_EQ(
+      dacpo_block_task_run(bad.data(), bad.size(), &out, &out_size, msg, sizeof(msg)),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("no block task"), std::string::npos) << msg;
+  EXPECT_EQ(dacpo_block_task_run(nullptr, 0, &out, &out_size, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  ASSERT_EQ(dacpo_block_task_run(
+                task.p, task.size, &result.p, &result.size, msg, sizeof(msg)),
+            DACPO_OK)
+      << msg;
+  // a result is not a task, a truncated result or one with bytes after it is refused
+  EXPECT_EQ(
+      dacpo_block_task_run(result.p, result.size, &out, &out_size, msg, sizeof(msg)),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_job_put_block(raw, result.p, result.size - 1, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  std::vector<unsigned char> longer(static_cast<unsigned char*>(result.p),
+                                    static_cast<unsigned char*>(result.p) +
+                                        result.size);
+  longer.push_back(0);
+  EXPECT_EQ(dacpo_job_put_block(raw, longer.data(), longer.size(), msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("after the block result"), std::string::npos) << msg;
+  // block 0's result claimed for block 1: its point count does not fit
+  std::vector<unsigned char> renamed(static_cast<unsigned char*>(result.p),
+                                     static_cast<unsigned char*>(result.p) +
+                                         result.size);
+  const uint64_t one = 1;
+  std::memcpy(renamed.data() + 8, &one, sizeof(one));
+  EXPECT_EQ(dacpo_job_put_block(raw, renamed.data(), renamed.size(), msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("block 1"), std::string::npos) << msg;
+  ASSERT_EQ(dacpo_job_put_block(raw, result.p, result.size, msg, sizeof(msg)), DACPO_OK)
+      << msg;
+  EXPECT_EQ(dacpo_job_put_block(raw, result.p, result.size, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("already"), std::string::npos) << msg;
+  for (size_t b = 1; b < dacpo_job_num_blocks(raw); ++b)
+    ASSERT_EQ(dacpo_job_orient_block(raw, b, msg, sizeof(msg)), DACPO_OK) << msg;
+  ASSERT_GT(dacpo_job_num_edges(raw), 0u);
+  UnitBytes edge;
+  ASSERT_EQ(dacpo_job_edge_task(raw, 0, &edge.p, &edge.size, msg, sizeof(msg)),
+            DACPO_OK)
+      << msg;
+  double alpha = 0.0, alpha_bar = 0.0;
+  EXPECT_EQ(
+      dacpo_edge_task_run(edge.p, edge.size - 4, &alpha, &alpha_bar, msg, sizeof(msg)),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(
+      dacpo_edge_task_run(task.p, task.size, &alpha, &alpha_bar, msg, sizeof(msg)),
+      DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("no edge task"), std::string::npos) << msg;
+  ASSERT_EQ(
+      dacpo_edge_task_run(edge.p, edge.size, &alpha, &alpha_bar, msg, sizeof(msg)),
+      DACPO_OK)
+      << msg;
+  EXPECT_EQ(dacpo_job_put_edge(raw, 0, std::nan(""), alpha_bar, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_job_put_edge(raw, 0, -1.0, alpha_bar, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  ASSERT_EQ(dacpo_job_put_edge(raw, 0, alpha, alpha_bar, msg, sizeof(msg)), DACPO_OK);
+  EXPECT_EQ(dacpo_job_put_edge(raw, 0, alpha, alpha_bar, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  for (size_t e = 1; e < dacpo_job_num_edges(raw); ++e)
+    ASSERT_EQ(dacpo_job_weigh_edge(raw, e, msg, sizeof(msg)), DACPO_OK) << msg;
+  ASSERT_EQ(dacpo_job_solve(raw), DACPO_OK) << dacpo_ctx_last_error(ctx.get());
+  std::vector<float> normals(3 * 3000);
+  ASSERT_EQ(dacpo_job_finish(raw, normals.data()), DACPO_OK);
+  dacpo_unit_bytes_free(nullptr);
 }
 
 TEST(DacpoJob, BadArgumentsAreRejectedWithAMessage)

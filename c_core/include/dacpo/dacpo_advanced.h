@@ -22,6 +22,20 @@
  * edges. The answer does not depend on the order: every block draws its random
  * numbers from its own stream of params->seed.
  *
+ * Units in another process (a cluster rank): a block's or an edge's work
+ * leaves the job as bytes and its answer comes back as bytes or two numbers,
+ *
+ *   dacpo_job_block_task  -> dacpo_block_task_run (anywhere) -> dacpo_job_put_block
+ *   dacpo_job_edge_task   -> dacpo_edge_task_run  (anywhere) -> dacpo_job_put_edge
+ *
+ * A task carries the run's parameters and everything its unit reads (a
+ * block's own and ring points; an edge's two block meshes), so the process
+ * that runs it needs no job and no cloud. dacpo_job_orient_block() runs the
+ * same code in the job's process: the answer is the same bytes either way.
+ * The byte format is native (byte order, struct layout): both ends must run
+ * the same build. A malformed, truncated or mismatched message is refused
+ * with INVALID_ARGUMENT. Free the bytes with dacpo_unit_bytes_free().
+ *
  * Errors: create, weigh_edges, solve and finish report like dacpo_orient()
  * (status, message in dacpo_ctx_last_error()); the units, which may run
  * concurrently, write their message into the caller's buffer (msg may be NULL).
@@ -80,6 +94,65 @@ dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size);
  *  params->num_threads threads; after every block. */
 DACPO_API dacpo_status
 dacpo_job_weigh_edges(dacpo_job* job);
+
+/** \brief Block b's work as bytes (its points and the run's parameters),
+ *  for dacpo_block_task_run() in any process. */
+DACPO_API dacpo_status
+dacpo_job_block_task(const dacpo_job* job,
+                     size_t b,
+                     void** bytes,
+                     size_t* size,
+                     char* msg,
+                     size_t msg_size);
+
+/** \brief Stages 2-3 of the block a task describes, without a job: the result
+ *  as bytes for dacpo_job_put_block(). Thread-safe. */
+DACPO_API dacpo_status
+dacpo_block_task_run(const void* task,
+                     size_t task_size,
+                     void** result,
+                     size_t* result_size,
+                     char* msg,
+                     size_t msg_size);
+
+/** \brief A block's result into the job (the block is then oriented, as after
+ *  dacpo_job_orient_block()); checks that it fits the block it names. Not
+ *  thread-safe against other calls on the same job. */
+DACPO_API dacpo_status
+dacpo_job_put_block(
+    dacpo_job* job, const void* bytes, size_t size, char* msg, size_t msg_size);
+
+/** \brief Edge e's work as bytes (the two block meshes; VCR weights), after
+ *  both its blocks. */
+DACPO_API dacpo_status
+dacpo_job_edge_task(const dacpo_job* job,
+                    size_t e,
+                    void** bytes,
+                    size_t* size,
+                    char* msg,
+                    size_t msg_size);
+
+/** \brief Stage 4 (VCR) of the edge a task describes, without a job. */
+DACPO_API dacpo_status
+dacpo_edge_task_run(const void* task,
+                    size_t task_size,
+                    double* alpha,
+                    double* alpha_bar,
+                    char* msg,
+                    size_t msg_size);
+
+/** \brief Edge e's evidence into the job (as after dacpo_job_weigh_edge()). */
+DACPO_API dacpo_status
+dacpo_job_put_edge(dacpo_job* job,
+                   size_t e,
+                   double alpha,
+                   double alpha_bar,
+                   char* msg,
+                   size_t msg_size);
+
+/** \brief Frees bytes a task or result call returned. NULL-safe. */
+DACPO_API void
+dacpo_unit_bytes_free(void* bytes);
 
 /** \brief Stages 5-6: block flips, relative signs of parts, the global sign. */
 DACPO_API dacpo_status

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# The MPI tool gives the normals of dacpo_orient() in one process, byte for
+# byte, for 1, 2 and 3 ranks (oversubscribed: more ranks than cores is fine),
+# and fails cleanly (a message and exit status 1 or 2 on every rank, no hang).
+#
+#   check_mpi.sh MAKE_SCENE ORIENT_MPI EVAL MPIEXEC WORKDIR
+set -euo pipefail
+MAKE=$1 TOOL=$2 EVAL=$3 MPIEXEC=$4 W=$5
+mkdir -p "$W"
+# root in a container: Open MPI refuses without these; no shared-memory
+# single-copy (ptrace is often not allowed there)
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_btl_vader_single_copy_mechanism=none
+run() { # ranks, then the tool's arguments
+  local np=$1; shift
+  timeout 300 "$MPIEXEC" -np "$np" --oversubscribe --bind-to none "$TOOL" "$@"
+}
+fail() { echo "FAIL: $*"; exit 1; }
+
+check_scene() { # name, make_scene args..., -- tool args...
+  local name=$1; shift
+  local make=() tool=()
+  while [ "$1" != "--" ]; do make+=("$1"); shift; done; shift
+  tool=("$@")
+  "$MAKE" "$W/$name.ply" "${make[@]}" > /dev/null
+  run 1 "$W/$name.ply" "$W/${name}_whole.ply" -whole -q "${tool[@]}"
+  for np in 1 2 3; do
+    run "$np" "$W/$name.ply" "$W/${name}_np$np.ply" -q -report "$W/${name}_np$np.json" \
+        "${tool[@]}"
+    cmp "$W/${name}_whole.ply" "$W/${name}_np$np.ply" ||
+      fail "$name: $np ranks differ from dacpo_orient() in one process"
+    [ "$(wc -l < "$W/${name}_np$np.json")" -eq "$np" ] ||
+      fail "$name: the report of $np ranks has not one line per rank"
+  done
+  # every rank ran units: the work was spread
+  grep -q '"rank": 2.*"blocks": [1-9]' "$W/${name}_np3.json" ||
+    fail "$name: rank 2 of 3 ran no block"
+  local wrong
+  wrong=$("$EVAL" "$W/$name.ply" "$W/${name}_np3.ply" -json |
+          sed -n 's/.*"wrong_pct": *\([0-9.]*\).*/\1/p')
+  echo "$name: identical for 1-3 ranks, $wrong % wrong"
+  awk -v w="$wrong" -v m="$MAX" 'BEGIN { exit !(w != "" && w <= m) }' ||
+    fail "$name: $wrong % wrong (bound $MAX %)"
+}
+
+# a room with estimated normals, seed 3, 11 blocks over 3 ranks
+MAX=10 check_scene room -scene room -n 20000 -seed 4 -- -estimate -seed 3 -blocks 11
+# two rooms (two components) with the file's normals as axes
+MAX=5 check_scene two_rooms -scene two_rooms -n 12000 -seed 2 -- -seed 5
+
+# bad input: a message and a non-zero status on every rank, no hang
+set +e
+out=$(run 2 "$W/missing.ply" "$W/x.ply" 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "cannot open" <<< "$out" || fail "missing input: status $st: $out"
+head -c 700 "$W/room.ply" > "$W/truncated.ply"
+set +e
+out=$(run 3 "$W/truncated.ply" "$W/x.ply" 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "truncated" <<< "$out" || fail "truncated input: status $st: $out"
+set +e
+out=$(run 2 "$W/room.ply" "$W/x.ply" -blocks many 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "unknown option or missing number" <<< "$out" ||
+  fail "bad option: status $st: $out"
+[ ! -e "$W/x.ply" ] || fail "a failed run left an output file"
+set +e
+out=$(run 2 "$W/room.ply" "$W/no_such_dir/x.ply" -q 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "cannot open" <<< "$out" || fail "unwritable output: status $st: $out"
+echo "mpi: all checks passed"

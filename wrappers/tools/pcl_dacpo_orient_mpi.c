@@ -1,0 +1,662 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * pcl_dacpo_orient_mpi: dacpo_orient() with its block and edge units spread
+ * over MPI ranks (dacpo_advanced.h). Plain C; MPI only here, never in the core.
+ *
+ *   mpirun -np R pcl_dacpo_orient_mpi in.ply out.ply [-estimate] [-seed S]
+ *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-report F] [-q]
+ *
+ * Rank 0 reads the cloud and runs stages 0-1 (k-NN graph, normals, blocks) and
+ * 5-6 (the 0-1 program, parts, global sign); the blocks (stages 2-3) and then
+ * the edges (stage 4, VCR) are dealt out to all ranks, rank 0 included, by
+ * estimated cost (a block: its own and ring points; an edge: the triangles of
+ * its two meshes), longest first to the least loaded rank. A block travels as
+ * its points and the run's parameters, its answer as normals, confidences and
+ * mesh; an edge as its two meshes, its answer as two numbers. Every unit runs
+ * the same code as in dacpo_orient() with the block's own random stream, so
+ * the normals are the same bytes for any number of ranks (-whole: rank 0 runs
+ * dacpo_orient() itself, for comparison).
+ *
+ * What this does not do yet: rank 0 holds the whole cloud (the other ranks
+ * hold only their units), reads it alone and writes the output alone.
+ *
+ * Output: binary PLY, float x y z nx ny nz, in input order. -report F writes
+ * one JSON object per rank (wall seconds per phase, peak RSS, bytes sent and
+ * received, units run).
+ *
+ * Exit status: 0 on success, 1 for bad arguments, 2 when reading, orienting or
+ * writing fails (every rank exits with the same status; a unit that fails
+ * during the exchange stops all ranks with MPI_Abort).
+ */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, nanosleep */
+
+#include <dacpo/dacpo.h>
+#include <dacpo/dacpo_advanced.h>
+
+#include "dacpo_ply.h"
+#include <sys/resource.h>
+
+#include <errno.h>
+#include <mpi.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+enum { TAG_BLOCK = 1, TAG_RESULT = 2, TAG_EDGE = 3 };
+
+typedef struct options {
+  const char* in;
+  const char* out;
+  const char* report;
+  int estimate, whole, quiet;
+  dacpo_params p;
+} options;
+
+/* What each rank measures. */
+typedef struct rank_report {
+  double wall[5]; /* read + stages 0-1, blocks, edges, solve + finish, write */
+  double peak_rss_mb;
+  double sent_mb, received_mb;
+  double blocks, edges; /* units run here */
+  double busy;          /* seconds in this rank's units */
+} rank_report;
+
+static double
+now(void)
+{
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double
+peak_rss_mb(void)
+{
+  struct rusage u;
+  getrusage(RUSAGE_SELF, &u);
+  return (double)u.ru_maxrss / 1024.0; /* Linux: kilobytes */
+}
+
+static int
+parse_size(const char* s, size_t* out)
+{
+  char* end = NULL;
+  errno = 0;
+  const unsigned long long v = strtoull(s, &end, 10);
+  if (errno || end == s || *end != '\0' || s[0] == '-')
+    return 0;
+  *out = (size_t)v;
+  return 1;
+}
+
+static int
+parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
+{
+  memset(o, 0, sizeof(*o));
+  dacpo_params_init(&o->p);
+  o->p.num_threads = 1;
+  size_t v = 0;
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    const int has_value = i + 1 < argc;
+    if (!strcmp(a, "-estimate"))
+      o->estimate = 1;
+    else if (!strcmp(a, "-whole"))
+      o->whole = 1;
+    else if (!strcmp(a, "-q"))
+      o->quiet = 1;
+    else if (!strcmp(a, "-report") && has_value)
+      o->report = argv[++i];
+    else if (a[0] == '-' && has_value && parse_size(argv[i + 1], &v)) {
+      ++i;
+      if (!strcmp(a, "-seed"))
+        o->p.seed = v;
+      else if (!strcmp(a, "-blocks"))
+        o->p.num_blocks = v;
+      else if (!strcmp(a, "-k"))
+        o->p.k = v;
+      else if (!strcmp(a, "-normal_k"))
+        o->p.normal_k = v;
+      else if (!strcmp(a, "-threads"))
+        o->p.num_threads = (unsigned)v;
+      else {
+        snprintf(msg, msg_size, "unknown option %s", a);
+        return 0;
+      }
+    }
+    else if (a[0] == '-') {
+      snprintf(msg, msg_size, "unknown option or missing number: %s", a);
+      return 0;
+    }
+    else if (!o->in)
+      o->in = a;
+    else if (!o->out)
+      o->out = a;
+    else {
+      snprintf(msg, msg_size, "one input and one output, got also %s", a);
+      return 0;
+    }
+  }
+  if (!o->in || !o->out) {
+    snprintf(msg,
+             msg_size,
+             "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply out.ply [-estimate] "
+             "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
+             "[-report F] [-q]");
+    return 0;
+  }
+  if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
+    return 0;
+  return 1;
+}
+
+/* ---- dealing out units ------------------------------------------------- */
+
+/* owner[u] for `count` units of cost[u]: costliest first (ties by id) to the
+ * least loaded rank (ties: the lowest rank). The same on every rank. */
+static int*
+deal(const double* cost, size_t count, int ranks)
+{
+  int* owner = malloc((count + 1) * sizeof(int));
+  size_t* order = malloc((count + 1) * sizeof(size_t));
+  double* load = calloc((size_t)ranks, sizeof(double));
+  if (!owner || !order || !load) {
+    free(owner);
+    owner = NULL;
+    goto done;
+  }
+  for (size_t u = 0; u < count; ++u)
+    order[u] = u;
+  for (size_t i = 1; i < count; ++i) { /* insertion sort: a few thousand units */
+    const size_t u = order[i];
+    size_t j = i;
+    while (j > 0 && (cost[order[j - 1]] < cost[u] ||
+                     (cost[order[j - 1]] == cost[u] && order[j - 1] > u))) {
+      order[j] = order[j - 1];
+      --j;
+    }
+    order[j] = u;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    int best = 0;
+    for (int r = 1; r < ranks; ++r)
+      if (load[r] < load[best])
+        best = r;
+    owner[order[i]] = best;
+    load[best] += cost[order[i]];
+  }
+done:
+  free(order);
+  free(load);
+  return owner;
+}
+
+/* Waits without spinning a core: with more ranks than cores a busy wait takes
+ * the core from a rank that computes. */
+static void
+wait_quietly(MPI_Request* req)
+{
+  int done = 0;
+  MPI_Test(req, &done, MPI_STATUS_IGNORE);
+  while (!done) {
+    const struct timespec ms = {0, 1000000};
+    nanosleep(&ms, NULL);
+    MPI_Test(req, &done, MPI_STATUS_IGNORE);
+  }
+}
+
+/* Receives one message of any size from `src` (MPI_ANY_SOURCE allowed) with
+ * `tag`; *from gets the sender. */
+static void*
+recv_bytes(int src, int tag, size_t* size, int* from, rank_report* rep)
+{
+  int flag = 0;
+  MPI_Status st;
+  MPI_Iprobe(src, tag, MPI_COMM_WORLD, &flag, &st);
+  while (!flag) {
+    const struct timespec ms = {0, 1000000};
+    nanosleep(&ms, NULL);
+    MPI_Iprobe(src, tag, MPI_COMM_WORLD, &flag, &st);
+  }
+  int count = 0;
+  MPI_Get_count(&st, MPI_BYTE, &count);
+  void* buf = malloc((size_t)count + 1);
+  MPI_Request req;
+  MPI_Irecv(buf, count, MPI_BYTE, st.MPI_SOURCE, tag, MPI_COMM_WORLD, &req);
+  wait_quietly(&req);
+  *size = (size_t)count;
+  if (from)
+    *from = st.MPI_SOURCE;
+  rep->received_mb += (double)count / 1048576.0;
+  return buf;
+}
+
+static void
+send_bytes(const void* buf, size_t size, int dst, int tag, rank_report* rep)
+{
+  MPI_Request req;
+  MPI_Isend(buf, (int)size, MPI_BYTE, dst, tag, MPI_COMM_WORLD, &req);
+  wait_quietly(&req);
+  rep->sent_mb += (double)size / 1048576.0;
+}
+
+/* A unit's failure on any rank ends the run on every rank. */
+static int
+all_ok(int ok)
+{
+  int all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return all;
+}
+
+/* A unit's task and result on a rank that is not rank 0. */
+typedef struct unit_msg {
+  void* task;
+  size_t task_size;
+  void* res;
+  size_t res_size;
+} unit_msg;
+
+/* A unit that fails in the middle of the exchange leaves the other ranks
+ * waiting for messages that will not come: the whole run stops (exit status 2). */
+static void
+unit_failed(int rank, const char* msg)
+{
+  fprintf(stderr, "Error (rank %d): %s\n", rank, msg);
+  MPI_Abort(MPI_COMM_WORLD, 2);
+}
+
+/* ---- blocks ------------------------------------------------------------ */
+
+/* Rank 0: block tasks out to their owners, its own blocks in place, results
+ * back into the job. Other ranks: their tasks in, results out. */
+static int
+run_blocks(dacpo_job* job, size_t nb, const int* owner, int rank, rank_report* rep)
+{
+  char msg[512] = "";
+  int ok = 1;
+  if (rank == 0) {
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] != 0) {
+        void* task = NULL;
+        size_t size = 0;
+        ok = dacpo_job_block_task(job, b, &task, &size, msg, sizeof(msg)) == DACPO_OK &&
+             size <= (size_t)INT32_MAX;
+        if (ok)
+          send_bytes(task, size, owner[b], TAG_BLOCK, rep);
+        dacpo_unit_bytes_free(task);
+      }
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] == 0) {
+        const double t = now();
+        ok = dacpo_job_orient_block(job, b, msg, sizeof(msg)) == DACPO_OK;
+        rep->busy += now() - t;
+        rep->blocks += 1.0;
+      }
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] != 0) {
+        size_t size = 0;
+        void* res = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
+        ok = dacpo_job_put_block(job, res, size, msg, sizeof(msg)) == DACPO_OK;
+        free(res);
+      }
+  }
+  else {
+    /* all tasks in first: rank 0 sends them one after the other and must not
+     * wait for this rank's computing; then all results out */
+    unit_msg* m = calloc(nb + 1, sizeof(unit_msg));
+    ok = m != NULL;
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] == rank)
+        m[b].task = recv_bytes(0, TAG_BLOCK, &m[b].task_size, NULL, rep);
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] == rank) {
+        const double t = now();
+        ok = dacpo_block_task_run(m[b].task,
+                                  m[b].task_size,
+                                  &m[b].res,
+                                  &m[b].res_size,
+                                  msg,
+                                  sizeof(msg)) == DACPO_OK;
+        rep->busy += now() - t;
+        free(m[b].task);
+        m[b].task = NULL;
+        rep->blocks += 1.0;
+      }
+    for (size_t b = 0; b < nb && ok; ++b)
+      if (owner[b] == rank) {
+        send_bytes(m[b].res, m[b].res_size, 0, TAG_RESULT, rep);
+        dacpo_unit_bytes_free(m[b].res);
+      }
+    free(m);
+  }
+  if (!ok)
+    unit_failed(rank, msg[0] ? msg : "a block failed");
+  return ok;
+}
+
+/* ---- edges ------------------------------------------------------------- */
+
+static int
+run_edges(dacpo_job* job, size_t ne, const int* owner, int rank, rank_report* rep)
+{
+  char msg[512] = "";
+  int ok = 1;
+  if (rank == 0) {
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] != 0) {
+        void* task = NULL;
+        size_t size = 0;
+        ok = dacpo_job_edge_task(job, e, &task, &size, msg, sizeof(msg)) == DACPO_OK &&
+             size <= (size_t)INT32_MAX;
+        if (ok)
+          send_bytes(task, size, owner[e], TAG_EDGE, rep);
+        dacpo_unit_bytes_free(task);
+      }
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] == 0) {
+        const double t = now();
+        ok = dacpo_job_weigh_edge(job, e, msg, sizeof(msg)) == DACPO_OK;
+        rep->busy += now() - t;
+        rep->edges += 1.0;
+      }
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] != 0) {
+        size_t size = 0;
+        double* r = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
+        ok = size == 3 * sizeof(double) && r[0] >= 0.0 && r[0] < (double)ne &&
+             dacpo_job_put_edge(job, (size_t)r[0], r[1], r[2], msg, sizeof(msg)) ==
+                 DACPO_OK;
+        free(r);
+      }
+  }
+  else {
+    unit_msg* m = calloc(ne + 1, sizeof(unit_msg));
+    double* ab = calloc(3 * ne + 1, sizeof(double)); /* edge id, alpha, alpha_bar */
+    ok = m && ab;
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] == rank)
+        m[e].task = recv_bytes(0, TAG_EDGE, &m[e].task_size, NULL, rep);
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] == rank) {
+        ab[3 * e] = (double)e;
+        const double t = now();
+        ok = dacpo_edge_task_run(m[e].task,
+                                 m[e].task_size,
+                                 &ab[3 * e + 1],
+                                 &ab[3 * e + 2],
+                                 msg,
+                                 sizeof(msg)) == DACPO_OK;
+        rep->busy += now() - t;
+        free(m[e].task);
+        m[e].task = NULL;
+        rep->edges += 1.0;
+      }
+    for (size_t e = 0; e < ne && ok; ++e)
+      if (owner[e] == rank)
+        send_bytes(ab + 3 * e, 3 * sizeof(double), 0, TAG_RESULT, rep);
+    free(m);
+    free(ab);
+  }
+  if (!ok)
+    unit_failed(rank, msg[0] ? msg : "an edge failed");
+  return ok;
+}
+
+/* ---- the run ------------------------------------------------------------ */
+
+/* Unit costs from rank 0 to all: blocks by their points (own + ring), edges by
+ * their two meshes (via the blocks' points: the meshes are on rank 0 only). */
+static int
+share_costs(
+    dacpo_job* job, int rank, size_t* nb, size_t* ne, double** bcost, double** ecost)
+{
+  uint64_t counts[2] = {0, 0};
+  if (rank == 0) {
+    counts[0] = dacpo_job_num_blocks(job);
+    counts[1] = dacpo_job_num_edges(job);
+  }
+  MPI_Bcast(counts, 2, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  *nb = (size_t)counts[0];
+  *ne = (size_t)counts[1];
+  *bcost = malloc((*nb + 1) * sizeof(double));
+  *ecost = malloc((*ne + 1) * sizeof(double));
+  if (!*bcost || !*ecost)
+    return 0;
+  if (rank == 0) {
+    for (size_t b = 0; b < *nb; ++b) {
+      void* task = NULL;
+      size_t size = 0;
+      dacpo_job_block_task(job, b, &task, &size, NULL, 0);
+      (*bcost)[b] = (double)size; /* 48 bytes per point plus a header */
+      dacpo_unit_bytes_free(task);
+    }
+    for (size_t e = 0; e < *ne; ++e) {
+      size_t a = 0, b = 0;
+      dacpo_job_edge_blocks(job, e, &a, &b);
+      (*ecost)[e] = (*bcost)[a] + (*bcost)[b];
+    }
+  }
+  MPI_Bcast(*bcost, (int)*nb, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Bcast(*ecost, (int)*ne, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  return 1;
+}
+
+/* Rank 0: read the cloud, stages 0-1. */
+static int
+prepare(const options* o,
+        dacpo_ctx* ctx,
+        dacpo_ply_cloud* cloud,
+        dacpo_params* p,
+        dacpo_job** job)
+{
+  char msg[512];
+  if (dacpo_ply_read(o->in, cloud, msg, sizeof(msg)) != DACPO_PLY_OK) {
+    fprintf(stderr, "Error: %s\n", msg);
+    return 0;
+  }
+  *p = o->p;
+  p->estimate_normals = o->estimate || cloud->normals == NULL;
+  if (!cloud->normals) {
+    cloud->normals = calloc(3 * cloud->n + 1, sizeof(float));
+    if (!cloud->normals)
+      return 0;
+  }
+  if (o->whole)
+    return 1;
+  if (dacpo_job_create(ctx, p, NULL, NULL, cloud->xyz, cloud->normals, cloud->n, job) !=
+      DACPO_OK) {
+    fprintf(stderr, "Error: %s\n", dacpo_ctx_last_error(ctx));
+    return 0;
+  }
+  return 1;
+}
+
+static void
+write_report(const options* o, const rank_report* all, int ranks)
+{
+  FILE* f = o->report ? fopen(o->report, "w") : NULL;
+  if (o->report && !f)
+    fprintf(stderr, "Error: cannot write %s: %s\n", o->report, strerror(errno));
+  if (!o->quiet)
+    printf("rank  read+0-1  blocks   edges  solve  write   busy  peak RSS MB  sent MB  "
+           "recv MB  blocks edges\n");
+  for (int r = 0; r < ranks; ++r) {
+    const rank_report* x = all + r;
+    if (!o->quiet)
+      printf("%4d %9.2f %7.2f %7.2f %6.2f %6.2f %6.2f %12.1f %8.1f %8.1f %7.0f %5.0f\n",
+             r,
+             x->wall[0],
+             x->wall[1],
+             x->wall[2],
+             x->wall[3],
+             x->wall[4],
+             x->busy,
+             x->peak_rss_mb,
+             x->sent_mb,
+             x->received_mb,
+             x->blocks,
+             x->edges);
+    if (f)
+      fprintf(f,
+              "{\"rank\": %d, \"ranks\": %d, \"read_stages01_s\": %.3f, \"blocks_s\": "
+              "%.3f, \"edges_s\": %.3f, \"solve_s\": %.3f, \"write_s\": %.3f, "
+              "\"busy_s\": %.3f, \"peak_rss_mb\": %.1f, \"sent_mb\": %.3f, "
+              "\"received_mb\": %.3f, "
+              "\"blocks\": %.0f, \"edges\": %.0f}\n",
+              r,
+              ranks,
+              x->wall[0],
+              x->wall[1],
+              x->wall[2],
+              x->wall[3],
+              x->wall[4],
+              x->busy,
+              x->peak_rss_mb,
+              x->sent_mb,
+              x->received_mb,
+              x->blocks,
+              x->edges);
+  }
+  if (f)
+    fclose(f);
+}
+
+/* Stages 2-6 over the ranks (or dacpo_orient() on rank 0 with -whole). */
+static int
+orient(const options* o,
+       dacpo_ctx* ctx,
+       dacpo_job* job,
+       dacpo_ply_cloud* cloud,
+       const dacpo_params* p,
+       int rank,
+       int ranks,
+       rank_report* rep,
+       double* t)
+{
+  if (o->whole) {
+    int ok = rank != 0 ||
+             dacpo_orient(ctx, p, NULL, NULL, cloud->xyz, cloud->normals, cloud->n) ==
+                 DACPO_OK;
+    if (!ok)
+      fprintf(stderr, "Error: %s\n", dacpo_ctx_last_error(ctx));
+    return all_ok(ok);
+  }
+  size_t nb = 0, ne = 0;
+  double *bcost = NULL, *ecost = NULL;
+  int* bowner = NULL;
+  int* eowner = NULL;
+  int ok = share_costs(job, rank, &nb, &ne, &bcost, &ecost);
+  if (ok) {
+    bowner = deal(bcost, nb, ranks);
+    eowner = deal(ecost, ne, ranks);
+    ok = bowner && eowner;
+  }
+  ok = all_ok(ok) && all_ok(run_blocks(job, nb, bowner, rank, rep));
+  rep->wall[1] = now() - *t;
+  *t = now();
+  ok = ok && all_ok(run_edges(job, ne, eowner, rank, rep));
+  rep->wall[2] = now() - *t;
+  *t = now();
+  if (ok && rank == 0) {
+    ok = dacpo_job_solve(job) == DACPO_OK &&
+         dacpo_job_finish(job, cloud->normals) == DACPO_OK;
+    if (!ok)
+      fprintf(stderr, "Error: %s\n", dacpo_ctx_last_error(ctx));
+  }
+  free(bcost);
+  free(ecost);
+  free(bowner);
+  free(eowner);
+  return all_ok(ok);
+}
+
+/* The output goes to a file beside the target first and is renamed over it
+ * only when complete: a failed run never leaves half a file under its name. */
+static int
+write_output(const char* path, const dacpo_ply_cloud* cloud)
+{
+  char msg[512];
+  const size_t len = strlen(path) + 32;
+  char* tmp = malloc(len);
+  int ok = tmp != NULL;
+  if (ok) {
+    snprintf(tmp, len, "%s.tmp%ld", path, (long)getpid());
+    ok = dacpo_ply_write(tmp,
+                         cloud->xyz,
+                         cloud->normals,
+                         cloud->n,
+                         "pcl_dacpo_orient_mpi",
+                         msg,
+                         sizeof(msg)) == DACPO_PLY_OK;
+    if (!ok)
+      fprintf(stderr, "Error: %s\n", msg);
+    else if (rename(tmp, path) != 0) {
+      fprintf(
+          stderr, "Error: cannot rename %s to %s: %s\n", tmp, path, strerror(errno));
+      ok = 0;
+    }
+    if (!ok)
+      remove(tmp);
+  }
+  free(tmp);
+  return ok;
+}
+
+int
+main(int argc, char** argv)
+{
+  MPI_Init(&argc, &argv);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  options o;
+  char msg[512];
+  if (!parse_args(argc, argv, &o, msg, sizeof(msg))) {
+    if (rank == 0)
+      fprintf(stderr, "Error: %s\n", msg);
+    MPI_Finalize();
+    return 1;
+  }
+  rank_report rep;
+  memset(&rep, 0, sizeof(rep));
+  double t = now();
+  dacpo_ctx* ctx = NULL;
+  dacpo_job* job = NULL;
+  dacpo_ply_cloud cloud = {0, NULL, NULL};
+  dacpo_params p = o.p;
+  int ok = 1;
+  if (rank == 0)
+    ok = dacpo_ctx_create(&ctx) == DACPO_OK && prepare(&o, ctx, &cloud, &p, &job);
+  ok = all_ok(ok);
+  rep.wall[0] = now() - t;
+  t = now();
+  ok = ok && orient(&o, ctx, job, &cloud, &p, rank, ranks, &rep, &t);
+  rep.wall[3] = now() - t;
+  t = now();
+  if (ok && rank == 0)
+    ok = write_output(o.out, &cloud);
+  ok = all_ok(ok);
+  rep.wall[4] = now() - t;
+  rep.peak_rss_mb = peak_rss_mb();
+  rank_report* all = rank == 0 ? calloc((size_t)ranks, sizeof(rank_report)) : NULL;
+  MPI_Gather(&rep,
+             (int)sizeof(rep),
+             MPI_BYTE,
+             all,
+             (int)sizeof(rep),
+             MPI_BYTE,
+             0,
+             MPI_COMM_WORLD);
+  if (rank == 0 && all && ok)
+    write_report(&o, all, ranks);
+  free(all);
+  dacpo_job_free(job);
+  dacpo_ctx_free(ctx);
+  dacpo_ply_cloud_free(&cloud);
+  MPI_Finalize();
+  return ok ? 0 : 2;
+}
