@@ -295,6 +295,8 @@ dacpo_block_task_pack(const dacpo_params* p,
   unit_header h = {{0}, block, n, n_own, (uint64_t)(want_mesh != 0)};
   memcpy(h.magic, task_magic, sizeof(h.magic));
   *size = sizeof(h) + sizeof(*p) + 6 * n * sizeof(double);
+  if (!bytes)
+    return DACPO_OK;
   writer w = {NULL, 0};
   DACPO_TRY(alloc_bytes(*size, bytes, &w, err));
   put(&w, &h, sizeof(h));
@@ -403,6 +405,8 @@ dacpo_edge_task_pack(const dacpo_params* p,
   unit_header h = {{0}, edge, 0, 0, 0};
   memcpy(h.magic, edge_magic, sizeof(h.magic));
   *size = sizeof(h) + sizeof(*p) + mesh_bytes(a) + mesh_bytes(b);
+  if (!bytes)
+    return DACPO_OK;
   writer w = {NULL, 0};
   DACPO_TRY(alloc_bytes(*size, bytes, &w, err));
   put(&w, &h, sizeof(h));

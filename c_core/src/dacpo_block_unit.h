@@ -45,7 +45,8 @@ dacpo_block_out_free(dacpo_block_out* out); /* NULL-safe; zeroes the struct */
 
 /* ---- byte format (same build on both ends: native byte order) ---------- */
 
-/* A block's work: the run's parameters, the block id, its points. */
+/* A block's work: the run's parameters, the block id, its points. bytes NULL:
+ * only *size is set (the same for the edge task). */
 dacpo_status
 dacpo_block_task_pack(const dacpo_params* p,
                       size_t block,

@@ -1159,6 +1159,9 @@ job_block_task(
               dacpo_job_num_blocks(job));
   const run_state* s = &job->s;
   const size_t n = block_size(s, b);
+  if (!bytes) /* size only */
+    return dacpo_block_task_pack(
+        &s->p, b, NULL, NULL, n, block_own(s, b), s->meshes != NULL, NULL, size, err);
   double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
   double* axes = dacpo_malloc_array(3 * n, sizeof(double));
   dacpo_status st = xyz && axes ? DACPO_OK : DACPO_OOM(err);
@@ -1181,10 +1184,11 @@ dacpo_job_block_task(const dacpo_job* job,
                      size_t msg_size)
 {
   dacpo_err err = {DACPO_OK, {0}};
-  if (!bytes || !size)
-    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: bytes or size is NULL");
+  if (!size)
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: size is NULL");
   else {
-    *bytes = NULL;
+    if (bytes)
+      *bytes = NULL;
     *size = 0;
     job_block_task(job, b, bytes, size, &err);
   }
@@ -1263,10 +1267,11 @@ dacpo_job_edge_task(const dacpo_job* job,
                     size_t msg_size)
 {
   dacpo_err err = {DACPO_OK, {0}};
-  if (!bytes || !size)
-    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: bytes or size is NULL");
+  if (!size)
+    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: size is NULL");
   else {
-    *bytes = NULL;
+    if (bytes)
+      *bytes = NULL;
     *size = 0;
     if (edge_ready(job, e, &err) == DACPO_OK) {
       const dacpo_block_edge* edge = &job->s.bgraph.edges[e];

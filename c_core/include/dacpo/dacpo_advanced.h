@@ -96,7 +96,8 @@ DACPO_API dacpo_status
 dacpo_job_weigh_edges(dacpo_job* job);
 
 /** \brief Block b's work as bytes (its points and the run's parameters),
- *  for dacpo_block_task_run() in any process. */
+ *  for dacpo_block_task_run() in any process. bytes NULL: only *size is set
+ *  (a measure of the block's cost: 48 bytes per own or ring point). */
 DACPO_API dacpo_status
 dacpo_job_block_task(const dacpo_job* job,
                      size_t b,
@@ -123,7 +124,7 @@ dacpo_job_put_block(
     dacpo_job* job, const void* bytes, size_t size, char* msg, size_t msg_size);
 
 /** \brief Edge e's work as bytes (the two block meshes; VCR weights), after
- *  both its blocks. */
+ *  both its blocks. bytes NULL: only *size is set (grows with the meshes). */
 DACPO_API dacpo_status
 dacpo_job_edge_task(const dacpo_job* job,
                     size_t e,
