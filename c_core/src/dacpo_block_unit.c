@@ -244,6 +244,12 @@ get_mesh(reader* r, dacpo_mesh* m, dacpo_err* err)
                   get(r, m->triangles, 3 * m->num_triangles, sizeof(int32_t)),
               DACPO_ERR_INVALID_ARGUMENT,
               "unit: a mesh runs past the end of the message");
+  for (size_t v = 0; v < 3 * m->num_vertices; ++v)
+    DACPO_CHECK(err,
+                isfinite(m->vertices[v]),
+                DACPO_ERR_INVALID_ARGUMENT,
+                "unit: mesh vertex %zu is not finite",
+                v / 3);
   for (size_t t = 0; t < 3 * m->num_triangles; ++t)
     DACPO_CHECK(err,
                 m->triangles[t] >= 0 && (size_t)m->triangles[t] < m->num_vertices,
@@ -358,6 +364,14 @@ result_unpack(reader* r, unit_header* h, dacpo_block_out* out, dacpo_err* err)
                   get(r, out->conf, no, sizeof(float)),
               DACPO_ERR_INVALID_ARGUMENT,
               "unit: block result runs past the end of the message");
+  for (size_t i = 0; i < n; ++i)
+    DACPO_CHECK(err,
+                isfinite(out->nrm[3 * i]) && isfinite(out->nrm[3 * i + 1]) &&
+                    isfinite(out->nrm[3 * i + 2]) &&
+                    (i >= no || (out->conf[i] >= 0.0f && out->conf[i] <= 1.0f)),
+                DACPO_ERR_INVALID_ARGUMENT,
+                "unit: normal or confidence %zu of the block result is out of range",
+                i);
   if (h->flag)
     DACPO_TRY(get_mesh(r, &out->mesh, err));
   DACPO_CHECK(err,
@@ -443,6 +457,26 @@ get_params(reader* r, dacpo_params* p, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* A task skips the input checks of stage 0: its points must be finite and
+ * its axes unit vectors, as the job made them. */
+static dacpo_status
+check_points(const double* xyz, const double* axes, size_t n, dacpo_err* err)
+{
+  for (size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    const double* a = axes + 3 * i;
+    const double len2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    DACPO_CHECK(err,
+                isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) &&
+                    fabs(len2 - 1.0) < 1e-6,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "unit: point %zu of the block task is not finite or its axis not a "
+                "unit vector",
+                i);
+  }
+  return DACPO_OK;
+}
+
 static dacpo_status
 block_task_run(const void* task,
                size_t task_size,
@@ -473,6 +507,9 @@ block_task_run(const void* task,
   if (st == DACPO_OK) {
     get(&r, xyz, 3 * n, sizeof(double));
     get(&r, axes, 3 * n, sizeof(double));
+    st = check_points(xyz, axes, n, err);
+  }
+  if (st == DACPO_OK) {
     st = dacpo_block_unit_run(
         &p, (size_t)h.id, xyz, axes, n, (size_t)h.n_own, h.flag != 0, &out, err);
   }

@@ -1009,6 +1009,11 @@ TEST(DacpoJob, UnitBytesAreCheckedBeforeUse)
   UnitBytes task, result, other;
   ASSERT_EQ(dacpo_job_block_task(raw, 0, &task.p, &task.size, msg, sizeof(msg)),
             DACPO_OK);
+  size_t asked = 0; // bytes NULL: the size alone
+  ASSERT_EQ(dacpo_job_block_task(raw, 0, nullptr, &asked, msg, sizeof(msg)), DACPO_OK);
+  EXPECT_EQ(asked, task.size);
+  EXPECT_EQ(dacpo_job_block_task(raw, 0, nullptr, nullptr, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_job_block_task(raw, 99, &other.p, &other.size, msg, sizeof(msg)),
             DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(other.p, nullptr);
@@ -1029,6 +1034,15 @@ TEST(DacpoJob, UnitBytesAreCheckedBeforeUse)
   EXPECT_NE(std::string(msg).find("no block task"), std::string::npos) << msg;
   EXPECT_EQ(dacpo_block_task_run(nullptr, 0, &out, &out_size, msg, sizeof(msg)),
             DACPO_ERR_INVALID_ARGUMENT);
+  // the last axis's z (the task's last 8 bytes) made NaN
+  std::vector<unsigned char> nan_point(static_cast<unsigned char*>(task.p),
+                                       static_cast<unsigned char*>(task.p) + task.size);
+  const double nan = std::nan("");
+  std::memcpy(nan_point.data() + task.size - 8, &nan, sizeof(nan));
+  EXPECT_EQ(dacpo_block_task_run(
+                nan_point.data(), nan_point.size(), &out, &out_size, msg, sizeof(msg)),
+            DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(msg).find("not finite"), std::string::npos) << msg;
   ASSERT_EQ(dacpo_block_task_run(
                 task.p, task.size, &result.p, &result.size, msg, sizeof(msg)),
             DACPO_OK)
@@ -1067,6 +1081,8 @@ TEST(DacpoJob, UnitBytesAreCheckedBeforeUse)
   ASSERT_EQ(dacpo_job_edge_task(raw, 0, &edge.p, &edge.size, msg, sizeof(msg)),
             DACPO_OK)
       << msg;
+  ASSERT_EQ(dacpo_job_edge_task(raw, 0, nullptr, &asked, msg, sizeof(msg)), DACPO_OK);
+  EXPECT_EQ(asked, edge.size);
   double alpha = 0.0, alpha_bar = 0.0;
   EXPECT_EQ(
       dacpo_edge_task_run(edge.p, edge.size - 4, &alpha, &alpha_bar, msg, sizeof(msg)),

@@ -284,140 +284,189 @@ unit_failed(int rank, const char* msg)
   MPI_Abort(MPI_COMM_WORLD, 2);
 }
 
-/* ---- blocks ------------------------------------------------------------ */
+/* ---- units ------------------------------------------------------------- */
 
-/* Rank 0: block tasks out to their owners, its own blocks in place, results
- * back into the job. Other ranks: their tasks in, results out. */
-static int
-run_blocks(dacpo_job* job, size_t nb, const int* owner, int rank, rank_report* rep)
+/* One kind of unit (blocks, edges) as the exchange sees it: its task made on
+ * rank 0, run in place on rank 0, run from its task on another rank (the
+ * answer as bytes), the answer put into the job on rank 0. */
+typedef struct unit_kind {
+  const char* name;
+  int tag;
+  dacpo_status (*task)(const dacpo_job*, size_t, void**, size_t*, char*, size_t);
+  dacpo_status (*local)(dacpo_job*, size_t, char*, size_t);
+  dacpo_status (*run)(const void*, size_t, size_t, void**, size_t*, char*, size_t);
+  void (*free_answer)(void*);
+  dacpo_status (*put)(dacpo_job*, const void*, size_t, char*, size_t);
+} unit_kind;
+
+static dacpo_status
+run_block(const void* task,
+          size_t size,
+          size_t unit,
+          void** answer,
+          size_t* answer_size,
+          char* msg,
+          size_t msg_size)
 {
-  char msg[512] = "";
+  (void)unit; /* the block's id travels in its result */
+  return dacpo_block_task_run(task, size, answer, answer_size, msg, msg_size);
+}
+
+/* An edge's answer: its id, alpha and alpha_bar as three doubles. */
+static dacpo_status
+run_edge(const void* task,
+         size_t size,
+         size_t unit,
+         void** answer,
+         size_t* answer_size,
+         char* msg,
+         size_t msg_size)
+{
+  double* ab = malloc(3 * sizeof(double));
+  if (!ab) {
+    snprintf(msg, msg_size, "out of memory for an edge's answer");
+    return DACPO_ERR_OUT_OF_MEMORY;
+  }
+  ab[0] = (double)unit;
+  const dacpo_status st =
+      dacpo_edge_task_run(task, size, &ab[1], &ab[2], msg, msg_size);
+  if (st != DACPO_OK) {
+    free(ab);
+    return st;
+  }
+  *answer = ab;
+  *answer_size = 3 * sizeof(double);
+  return DACPO_OK;
+}
+
+static dacpo_status
+put_edge(dacpo_job* job, const void* answer, size_t size, char* msg, size_t msg_size)
+{
+  double ab[3];
+  if (size != sizeof(ab)) {
+    snprintf(msg, msg_size, "an edge's answer of %zu bytes", size);
+    return DACPO_ERR_INVALID_ARGUMENT;
+  }
+  memcpy(ab, answer, sizeof(ab));
+  if (!(ab[0] >= 0.0 && ab[0] < (double)dacpo_job_num_edges(job))) {
+    snprintf(msg, msg_size, "an edge's answer names edge %g", ab[0]);
+    return DACPO_ERR_INVALID_ARGUMENT;
+  }
+  return dacpo_job_put_edge(job, (size_t)ab[0], ab[1], ab[2], msg, msg_size);
+}
+
+static const unit_kind blocks_kind = {"block",
+                                      TAG_BLOCK,
+                                      dacpo_job_block_task,
+                                      dacpo_job_orient_block,
+                                      run_block,
+                                      dacpo_unit_bytes_free,
+                                      dacpo_job_put_block};
+static const unit_kind edges_kind = {"edge",
+                                     TAG_EDGE,
+                                     dacpo_job_edge_task,
+                                     dacpo_job_weigh_edge,
+                                     run_edge,
+                                     free,
+                                     put_edge};
+
+/* Rank 0: the tasks out to their owners, its own units in place, the answers
+ * back into the job. */
+static int
+deal_from_rank0(dacpo_job* job,
+                const unit_kind* k,
+                size_t count,
+                const int* owner,
+                rank_report* rep,
+                double* ran,
+                char* msg,
+                size_t msg_size)
+{
   int ok = 1;
-  if (rank == 0) {
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] != 0) {
-        void* task = NULL;
-        size_t size = 0;
-        ok = dacpo_job_block_task(job, b, &task, &size, msg, sizeof(msg)) == DACPO_OK &&
-             size <= (size_t)INT32_MAX;
-        if (ok)
-          send_bytes(task, size, owner[b], TAG_BLOCK, rep);
-        dacpo_unit_bytes_free(task);
-      }
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] == 0) {
-        const double t = now();
-        ok = dacpo_job_orient_block(job, b, msg, sizeof(msg)) == DACPO_OK;
-        rep->busy += now() - t;
-        rep->blocks += 1.0;
-      }
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] != 0) {
-        size_t size = 0;
-        void* res = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
-        ok = dacpo_job_put_block(job, res, size, msg, sizeof(msg)) == DACPO_OK;
-        free(res);
-      }
-  }
-  else {
-    /* all tasks in first: rank 0 sends them one after the other and must not
-     * wait for this rank's computing; then all results out */
-    unit_msg* m = calloc(nb + 1, sizeof(unit_msg));
-    ok = m != NULL;
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] == rank)
-        m[b].task = recv_bytes(0, TAG_BLOCK, &m[b].task_size, NULL, rep);
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] == rank) {
-        const double t = now();
-        ok = dacpo_block_task_run(m[b].task,
-                                  m[b].task_size,
-                                  &m[b].res,
-                                  &m[b].res_size,
-                                  msg,
-                                  sizeof(msg)) == DACPO_OK;
-        rep->busy += now() - t;
-        free(m[b].task);
-        m[b].task = NULL;
-        rep->blocks += 1.0;
-      }
-    for (size_t b = 0; b < nb && ok; ++b)
-      if (owner[b] == rank) {
-        send_bytes(m[b].res, m[b].res_size, 0, TAG_RESULT, rep);
-        dacpo_unit_bytes_free(m[b].res);
-      }
-    free(m);
-  }
-  if (!ok)
-    unit_failed(rank, msg[0] ? msg : "a block failed");
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] != 0) {
+      void* task = NULL;
+      size_t size = 0;
+      ok = k->task(job, u, &task, &size, msg, msg_size) == DACPO_OK &&
+           size <= (size_t)INT32_MAX;
+      if (ok)
+        send_bytes(task, size, owner[u], k->tag, rep);
+      dacpo_unit_bytes_free(task);
+    }
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] == 0) {
+      const double t = now();
+      ok = k->local(job, u, msg, msg_size) == DACPO_OK;
+      rep->busy += now() - t;
+      *ran += 1.0;
+    }
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] != 0) {
+      size_t size = 0;
+      void* answer = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
+      ok = k->put(job, answer, size, msg, msg_size) == DACPO_OK;
+      free(answer);
+    }
   return ok;
 }
 
-/* ---- edges ------------------------------------------------------------- */
+/* Another rank: all its tasks in first (rank 0 sends them one after the
+ * other and must not wait for this rank's computing), then run, then all
+ * answers out. */
+static int
+work_for_rank0(const unit_kind* k,
+               size_t count,
+               const int* owner,
+               int rank,
+               rank_report* rep,
+               double* ran,
+               char* msg,
+               size_t msg_size)
+{
+  unit_msg* m = calloc(count + 1, sizeof(unit_msg));
+  int ok = m != NULL;
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] == rank)
+      m[u].task = recv_bytes(0, k->tag, &m[u].task_size, NULL, rep);
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] == rank) {
+      const double t = now();
+      ok =
+          k->run(
+              m[u].task, m[u].task_size, u, &m[u].res, &m[u].res_size, msg, msg_size) ==
+          DACPO_OK;
+      rep->busy += now() - t;
+      free(m[u].task);
+      m[u].task = NULL;
+      *ran += 1.0;
+    }
+  for (size_t u = 0; u < count && ok; ++u)
+    if (owner[u] == rank) {
+      send_bytes(m[u].res, m[u].res_size, 0, TAG_RESULT, rep);
+      k->free_answer(m[u].res);
+    }
+  free(m);
+  return ok;
+}
 
 static int
-run_edges(dacpo_job* job, size_t ne, const int* owner, int rank, rank_report* rep)
+run_units(dacpo_job* job,
+          const unit_kind* k,
+          size_t count,
+          const int* owner,
+          int rank,
+          rank_report* rep,
+          double* ran)
 {
   char msg[512] = "";
-  int ok = 1;
-  if (rank == 0) {
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] != 0) {
-        void* task = NULL;
-        size_t size = 0;
-        ok = dacpo_job_edge_task(job, e, &task, &size, msg, sizeof(msg)) == DACPO_OK &&
-             size <= (size_t)INT32_MAX;
-        if (ok)
-          send_bytes(task, size, owner[e], TAG_EDGE, rep);
-        dacpo_unit_bytes_free(task);
-      }
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] == 0) {
-        const double t = now();
-        ok = dacpo_job_weigh_edge(job, e, msg, sizeof(msg)) == DACPO_OK;
-        rep->busy += now() - t;
-        rep->edges += 1.0;
-      }
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] != 0) {
-        size_t size = 0;
-        double* r = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
-        ok = size == 3 * sizeof(double) && r[0] >= 0.0 && r[0] < (double)ne &&
-             dacpo_job_put_edge(job, (size_t)r[0], r[1], r[2], msg, sizeof(msg)) ==
-                 DACPO_OK;
-        free(r);
-      }
+  const int ok =
+      rank == 0 ? deal_from_rank0(job, k, count, owner, rep, ran, msg, sizeof(msg))
+                : work_for_rank0(k, count, owner, rank, rep, ran, msg, sizeof(msg));
+  if (!ok) {
+    char what[64];
+    snprintf(what, sizeof(what), "a %s failed", k->name);
+    unit_failed(rank, msg[0] ? msg : what);
   }
-  else {
-    unit_msg* m = calloc(ne + 1, sizeof(unit_msg));
-    double* ab = calloc(3 * ne + 1, sizeof(double)); /* edge id, alpha, alpha_bar */
-    ok = m && ab;
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] == rank)
-        m[e].task = recv_bytes(0, TAG_EDGE, &m[e].task_size, NULL, rep);
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] == rank) {
-        ab[3 * e] = (double)e;
-        const double t = now();
-        ok = dacpo_edge_task_run(m[e].task,
-                                 m[e].task_size,
-                                 &ab[3 * e + 1],
-                                 &ab[3 * e + 2],
-                                 msg,
-                                 sizeof(msg)) == DACPO_OK;
-        rep->busy += now() - t;
-        free(m[e].task);
-        m[e].task = NULL;
-        rep->edges += 1.0;
-      }
-    for (size_t e = 0; e < ne && ok; ++e)
-      if (owner[e] == rank)
-        send_bytes(ab + 3 * e, 3 * sizeof(double), 0, TAG_RESULT, rep);
-    free(m);
-    free(ab);
-  }
-  if (!ok)
-    unit_failed(rank, msg[0] ? msg : "an edge failed");
   return ok;
 }
 
@@ -553,12 +602,14 @@ orient(const options* o,
   size_t nb = 0, ne = 0;
   double* bcost = share_costs(job, rank, 0, &nb);
   int* bowner = bcost ? deal(bcost, nb, ranks) : NULL;
-  int ok = all_ok(bowner != NULL) && all_ok(run_blocks(job, nb, bowner, rank, rep));
+  int ok = all_ok(bowner != NULL) &&
+           all_ok(run_units(job, &blocks_kind, nb, bowner, rank, rep, &rep->blocks));
   rep->wall[1] = now() - *t;
   *t = now();
   double* ecost = ok ? share_costs(job, rank, 1, &ne) : NULL;
   int* eowner = ecost ? deal(ecost, ne, ranks) : NULL;
-  ok = ok && all_ok(eowner != NULL) && all_ok(run_edges(job, ne, eowner, rank, rep));
+  ok = ok && all_ok(eowner != NULL) &&
+       all_ok(run_units(job, &edges_kind, ne, eowner, rank, rep, &rep->edges));
   rep->wall[2] = now() - *t;
   *t = now();
   if (ok && rank == 0) {
