@@ -19,6 +19,7 @@
 #include "dacpo_ilp.h"
 #include "dacpo_input.h"
 #include "dacpo_ipsr.h"
+#include "dacpo_job_internal.h"
 #include "dacpo_knn.h"
 #include "dacpo_normals.h"
 #include "dacpo_parallel.h"
@@ -31,42 +32,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct run_state {
-  dacpo_params p;
-  const dacpo_progress* progress;
-  dacpo_cloud cloud;
-  dacpo_knn_graph knn;
-  dacpo_adjacency adj;
-  int32_t* component;       /* component the stages work with (0 after bridging) */
-  int32_t* input_component; /* component of the k-NN graph, as reported */
-  size_t num_components;
-  int32_t largest_component_id; /* input component with the most points */
-  float* curvature;             /* per distinct point, only when estimated */
-  dacpo_blocks blocks;
-  dacpo_block_graph bgraph;
-  double* oriented; /* 3n: normals after stages 2-3, before flips */
-  float*
-      point_conf; /* n: in-block confidence (stage 2, halved where stage 3 disagreed) */
-  double* ring_oriented;  /* 3 per ring entry: each block's normals of its ring */
-  dacpo_mesh* meshes;     /* per block, only for VCR weights */
-  dacpo_mesh scene_mesh;  /* keep_mesh: one surface from the final normals */
-  dacpo_ipsr_stats* ipsr; /* per block */
-  double* block_seconds;  /* per block: [2b] dipole, [2b+1] iPSR */
-  uint8_t* flips;         /* per block */
-  uint32_t* cue_votes;   /* 2 per block: own points whose side cue agrees / disagrees */
-  float* block_conf;     /* per block: how firmly stage 5 holds its flip */
-  double evidence_scale; /* median alpha + alpha-bar of the block edges (stage 5) */
-  int32_t* part;         /* n: part of each point (VIEWPOINT policy) */
-  int8_t* part_sign;     /* per part */
-  double* part_conf;     /* per part */
-  double global_sign;    /* +1 or -1: stage 6 */
-  dacpo_ilp_result ilp;
-  /* what the work units have done (dacpo_advanced.h checks the order) */
-  uint8_t* block_done; /* per block: stages 2-3 */
-  uint8_t* edge_done;  /* per edge: stage 4 */
-  int solved, finished;
-} run_state;
 
 static void
 run_state_free(run_state* s)
@@ -208,8 +173,8 @@ estimate_normals(run_state* s, dacpo_err* err)
 
 /* Block b's points, own first, then its ring (the ring gives continuity to
  * propagation and Poisson but is not part of the output). */
-static void
-gather_block(const run_state* s, size_t b, double* xyz, double* axes)
+void
+dacpo_run_gather_block(const run_state* s, size_t b, double* xyz, double* axes)
 {
   const dacpo_blocks* bl = &s->blocks;
   const size_t own0 = bl->own_start[b], no = bl->own_start[b + 1] - own0;
@@ -221,25 +186,26 @@ gather_block(const run_state* s, size_t b, double* xyz, double* axes)
   }
 }
 
-static size_t
-block_own(const run_state* s, size_t b)
+size_t
+dacpo_run_block_own(const run_state* s, size_t b)
 {
   return s->blocks.own_start[b + 1] - s->blocks.own_start[b];
 }
 
-static size_t
-block_size(const run_state* s, size_t b)
+size_t
+dacpo_run_block_size(const run_state* s, size_t b)
 {
-  return block_own(s, b) + s->blocks.ring_start[b + 1] - s->blocks.ring_start[b];
+  return dacpo_run_block_own(s, b) + s->blocks.ring_start[b + 1] -
+         s->blocks.ring_start[b];
 }
 
 /* Block b's results into the run; its mesh moves into the run. */
-static void
-store_block(run_state* s, size_t b, dacpo_block_out* out)
+void
+dacpo_run_store_block(run_state* s, size_t b, dacpo_block_out* out)
 {
   const dacpo_blocks* bl = &s->blocks;
-  const size_t own0 = bl->own_start[b], no = block_own(s, b);
-  const size_t ring0 = bl->ring_start[b], nr = block_size(s, b) - no;
+  const size_t own0 = bl->own_start[b], no = dacpo_run_block_own(s, b);
+  const size_t ring0 = bl->ring_start[b], nr = dacpo_run_block_size(s, b) - no;
   for (size_t i = 0; i < no; ++i) {
     const size_t q = (size_t)bl->own[own0 + i];
     memcpy(s->oriented + 3 * q, out->nrm + 3 * i, 3 * sizeof(double));
@@ -259,23 +225,30 @@ store_block(run_state* s, size_t b, dacpo_block_out* out)
   s->block_done[b] = 1;
 }
 
-static dacpo_status
-orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
+dacpo_status
+dacpo_run_orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
 {
   run_state* s = user;
-  const size_t n = block_size(s, b);
+  const size_t n = dacpo_run_block_size(s, b);
   double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
   double* axes = dacpo_malloc_array(3 * n, sizeof(double));
   dacpo_block_out out;
   memset(&out, 0, sizeof(out));
   dacpo_status st = xyz && axes ? DACPO_OK : DACPO_OOM(err);
   if (st == DACPO_OK) {
-    gather_block(s, b, xyz, axes);
-    st = dacpo_block_unit_run(
-        &s->p, b, xyz, axes, n, block_own(s, b), s->meshes != NULL, &out, err);
+    dacpo_run_gather_block(s, b, xyz, axes);
+    st = dacpo_block_unit_run(&s->p,
+                              b,
+                              xyz,
+                              axes,
+                              n,
+                              dacpo_run_block_own(s, b),
+                              s->meshes != NULL,
+                              &out,
+                              err);
   }
   if (st == DACPO_OK)
-    store_block(s, b, &out);
+    dacpo_run_store_block(s, b, &out);
   (void)thread_id;
   free(xyz);
   free(axes);
@@ -285,8 +258,8 @@ orient_block(void* user, size_t b, unsigned thread_id, dacpo_err* err)
 
 /* ---- stage 4: VCR weights, one edge at a time -------------------------- */
 
-static dacpo_status
-weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
+dacpo_status
+dacpo_run_weigh_edge_vcr(void* user, size_t e, unsigned thread_id, dacpo_err* err)
 {
   run_state* s = user;
   dacpo_block_edge* edge = &s->bgraph.edges[e];
@@ -892,7 +865,7 @@ orient_blocks(run_state* s, dacpo_err* err)
   DACPO_TRY(
       dacpo_parallel_for(nb,
                          s->p.num_threads,
-                         orient_block,
+                         dacpo_run_orient_block,
                          s,
                          s->progress,
                          s->p.ipsr_enabled ? DACPO_STAGE_IPSR : DACPO_STAGE_DIPOLE,
@@ -908,7 +881,7 @@ weigh_edges(run_state* s, dacpo_err* err)
   if (s->p.edge_weight == DACPO_WEIGHT_VCR)
     DACPO_TRY(dacpo_parallel_for(s->bgraph.num_edges,
                                  s->p.num_threads,
-                                 weigh_edge_vcr,
+                                 dacpo_run_weigh_edge_vcr,
                                  s,
                                  s->progress,
                                  DACPO_STAGE_EDGE_WEIGHTS,
@@ -924,13 +897,6 @@ weigh_edges(run_state* s, dacpo_err* err)
 }
 
 /* ---- the run as work units (dacpo_advanced.h) ---------------------------- */
-
-struct dacpo_job {
-  dacpo_ctx* ctx;
-  run_state s;
-  double t0; /* start of the run */
-  double t;  /* end of the last stage timed */
-};
 
 /* Records the wall time of `stage` since the last one and asks the progress
  * callback whether to go on. */
@@ -1125,214 +1091,6 @@ dacpo_job_weigh_edges(dacpo_job* job)
   if (status == DACPO_OK)
     status = weigh_edges(&job->s, &err);
   return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
-}
-
-/* ---- units for another process (dacpo_advanced.h) ------------------------ */
-
-/* Whether block b may take a result: a valid id, not yet oriented. */
-static dacpo_status
-block_open(const dacpo_job* job, size_t b, dacpo_err* err)
-{
-  DACPO_CHECK(err,
-              job && b < job->s.blocks.num_blocks,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: block %zu of %zu",
-              b,
-              dacpo_job_num_blocks(job));
-  DACPO_CHECK(err,
-              !job->s.block_done[b],
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: block %zu is oriented already",
-              b);
-  return DACPO_OK;
-}
-
-static dacpo_status
-job_block_task(
-    const dacpo_job* job, size_t b, void** bytes, size_t* size, dacpo_err* err)
-{
-  DACPO_CHECK(err,
-              job && b < job->s.blocks.num_blocks,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: block %zu of %zu",
-              b,
-              dacpo_job_num_blocks(job));
-  const run_state* s = &job->s;
-  const size_t n = block_size(s, b);
-  if (!bytes) /* size only */
-    return dacpo_block_task_pack(
-        &s->p, b, NULL, NULL, n, block_own(s, b), s->meshes != NULL, NULL, size, err);
-  double* xyz = dacpo_malloc_array(3 * n, sizeof(double));
-  double* axes = dacpo_malloc_array(3 * n, sizeof(double));
-  dacpo_status st = xyz && axes ? DACPO_OK : DACPO_OOM(err);
-  if (st == DACPO_OK) {
-    gather_block(s, b, xyz, axes);
-    st = dacpo_block_task_pack(
-        &s->p, b, xyz, axes, n, block_own(s, b), s->meshes != NULL, bytes, size, err);
-  }
-  free(xyz);
-  free(axes);
-  return st;
-}
-
-dacpo_status
-dacpo_job_block_task(const dacpo_job* job,
-                     size_t b,
-                     void** bytes,
-                     size_t* size,
-                     char* msg,
-                     size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (!size)
-    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: size is NULL");
-  else {
-    if (bytes)
-      *bytes = NULL;
-    *size = 0;
-    job_block_task(job, b, bytes, size, &err);
-  }
-  return dacpo_unit_message(&err, msg, msg_size);
-}
-
-static dacpo_status
-job_put_block(dacpo_job* job, const void* bytes, size_t size, dacpo_err* err)
-{
-  DACPO_CHECK(err, job != NULL, DACPO_ERR_INVALID_ARGUMENT, "job: job is NULL");
-  dacpo_block_out out;
-  size_t b, n, no;
-  int has_mesh;
-  DACPO_TRY(dacpo_block_result_unpack(bytes, size, &b, &n, &no, &has_mesh, &out, err));
-  dacpo_status st = block_open(job, b, err);
-  if (st == DACPO_OK && (n != block_size(&job->s, b) || no != block_own(&job->s, b) ||
-                         has_mesh != (job->s.meshes != NULL)))
-    st = dacpo_err_set(err,
-                       DACPO_ERR_INVALID_ARGUMENT,
-                       "job: the result for block %zu holds %zu points (%zu own, mesh "
-                       "%d), the block %zu (%zu own, mesh %d)",
-                       b,
-                       n,
-                       no,
-                       has_mesh,
-                       block_size(&job->s, b),
-                       block_own(&job->s, b),
-                       job->s.meshes != NULL);
-  if (st == DACPO_OK)
-    store_block(&job->s, b, &out);
-  dacpo_block_out_free(&out);
-  return st;
-}
-
-dacpo_status
-dacpo_job_put_block(
-    dacpo_job* job, const void* bytes, size_t size, char* msg, size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  job_put_block(job, bytes, size, &err);
-  return dacpo_unit_message(&err, msg, msg_size);
-}
-
-/* Whether edge e can be weighed by VCR now: a valid id, VCR weights, both
- * blocks oriented. */
-static dacpo_status
-edge_ready(const dacpo_job* job, size_t e, dacpo_err* err)
-{
-  DACPO_CHECK(err,
-              job && e < job->s.bgraph.num_edges,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: edge %zu of %zu",
-              e,
-              dacpo_job_num_edges(job));
-  DACPO_CHECK(err,
-              job->s.p.edge_weight == DACPO_WEIGHT_VCR,
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: edge by edge only with VCR weights; use dacpo_job_weigh_edges");
-  const dacpo_block_edge* edge = &job->s.bgraph.edges[e];
-  DACPO_CHECK(err,
-              job->s.block_done[edge->a] && job->s.block_done[edge->b],
-              DACPO_ERR_INVALID_ARGUMENT,
-              "job: edge %zu before its blocks %d and %d are oriented",
-              e,
-              (int)edge->a,
-              (int)edge->b);
-  return DACPO_OK;
-}
-
-dacpo_status
-dacpo_job_edge_task(const dacpo_job* job,
-                    size_t e,
-                    void** bytes,
-                    size_t* size,
-                    char* msg,
-                    size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (!size)
-    dacpo_err_set(&err, DACPO_ERR_INVALID_ARGUMENT, "job: size is NULL");
-  else {
-    if (bytes)
-      *bytes = NULL;
-    *size = 0;
-    if (edge_ready(job, e, &err) == DACPO_OK) {
-      const dacpo_block_edge* edge = &job->s.bgraph.edges[e];
-      dacpo_edge_task_pack(&job->s.p,
-                           e,
-                           &job->s.meshes[edge->a],
-                           &job->s.meshes[edge->b],
-                           bytes,
-                           size,
-                           &err);
-    }
-  }
-  return dacpo_unit_message(&err, msg, msg_size);
-}
-
-dacpo_status
-dacpo_job_put_edge(dacpo_job* job,
-                   size_t e,
-                   double alpha,
-                   double alpha_bar,
-                   char* msg,
-                   size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (edge_ready(job, e, &err) == DACPO_OK) {
-    if (job->s.edge_done[e])
-      dacpo_err_set(
-          &err, DACPO_ERR_INVALID_ARGUMENT, "job: edge %zu is weighed already", e);
-    else if (!(alpha >= 0.0 && alpha_bar >= 0.0 && isfinite(alpha) &&
-               isfinite(alpha_bar)))
-      dacpo_err_set(&err,
-                    DACPO_ERR_INVALID_ARGUMENT,
-                    "job: edge %zu: alpha %g and alpha_bar %g must be finite and >= 0",
-                    e,
-                    alpha,
-                    alpha_bar);
-    else {
-      job->s.bgraph.edges[e].alpha = alpha;
-      job->s.bgraph.edges[e].alpha_bar = alpha_bar;
-      job->s.edge_done[e] = 1;
-    }
-  }
-  return dacpo_unit_message(&err, msg, msg_size);
-}
-
-dacpo_status
-dacpo_job_orient_block(dacpo_job* job, size_t b, char* msg, size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (block_open(job, b, &err) == DACPO_OK)
-    orient_block(&job->s, b, 0, &err);
-  return dacpo_unit_message(&err, msg, msg_size);
-}
-
-dacpo_status
-dacpo_job_weigh_edge(dacpo_job* job, size_t e, char* msg, size_t msg_size)
-{
-  dacpo_err err = {DACPO_OK, {0}};
-  if (edge_ready(job, e, &err) == DACPO_OK)
-    weigh_edge_vcr(&job->s, e, 0, &err);
-  return dacpo_unit_message(&err, msg, msg_size);
 }
 
 /* Stages 5-6 and the parts. */
