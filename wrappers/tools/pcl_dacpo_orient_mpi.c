@@ -447,9 +447,21 @@ work_for_rank0(const unit_kind* k,
     }
   for (size_t u = 0; u < count && ok; ++u)
     if (owner[u] == rank) {
-      send_bytes(m[u].res, m[u].res_size, 0, TAG_RESULT, rep);
-      k->free_answer(m[u].res);
+      /* MPI counts are int: a block of some 40M points would not fit */
+      ok = m[u].res_size <= (size_t)INT32_MAX;
+      if (ok)
+        send_bytes(m[u].res, m[u].res_size, 0, TAG_RESULT, rep);
+      else
+        snprintf(msg,
+                 msg_size,
+                 "the answer of %s %zu has %zu bytes",
+                 k->name,
+                 u,
+                 m[u].res_size);
     }
+  for (size_t u = 0; u < count; ++u)
+    if (m && owner[u] == rank)
+      k->free_answer(m[u].res);
   free(m);
   return ok;
 }
