@@ -258,10 +258,11 @@ send_bytes(const void* buf, size_t size, int dst, int tag, rank_report* rep)
   rep->sent_mb += (double)size / 1048576.0;
 }
 
-/* A failure on any rank ends the run on every rank. Also where the other
- * ranks wait for rank 0's stages 0-1: a blocking MPI_Allreduce spins, and on
- * 2 cores two waiting ranks took rank 0's second thread (10M points: stages
- * 0-1 46 s alone, 52 / 66 s beside 1 / 2 waiting ranks). */
+/* A failure on any rank ends the run on every rank. The other ranks also wait
+ * here through rank 0's stages 0-1: a blocking MPI_Allreduce would spin on a
+ * core that rank 0's threads may need when ranks share cores (no gain could be
+ * measured on 2 cores: rank 0's stages 0-1 of the 10M floor took 44-66 s over
+ * runs with 1-4 ranks either way, run-to-run noise included). */
 static int
 all_ok(int ok)
 {
