@@ -68,4 +68,9 @@ set +e
 out=$(run 2 "$W/room.ply" "$W/no_such_dir/x.ply" -q 2>&1); st=$?
 set -e
 [ "$st" -ne 0 ] && grep -q "cannot open" <<< "$out" || fail "unwritable output: status $st: $out"
+# help: every option named, status 0
+out=$(run 2 -h)
+for opt in -estimate -seed -blocks -k -normal_k -threads -whole -report -q; do
+  grep -q -- " $opt " <<< "$out" || fail "help does not name $opt"
+done
 echo "mpi: all checks passed"
