@@ -16,9 +16,9 @@ command -v clang >/dev/null && command -v clang++ >/dev/null ||
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDACPO_BUILD_FUZZERS=ON -DDACPO_BUILD_TESTS=OFF -DDACPO_BUILD_SAMPLES=OFF \
   -DDACPO_BUILD_TOOLS=OFF -DDACPO_BUILD_PYTHON=OFF >/dev/null
-cmake --build "$build" -j "$(nproc)" --target fuzz_orient fuzz_file_checks fuzz_units >/dev/null
+cmake --build "$build" -j "$(nproc)" --target fuzz_orient fuzz_file_checks fuzz_units fuzz_point_files >/dev/null
 
-targets=(file_checks orient units)
+targets=(file_checks orient units point_files)
 per=$((seconds / ${#targets[@]}))
 [ "$per" -ge 1 ] || per=1
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"

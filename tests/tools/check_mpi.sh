@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The MPI tool gives the normals of dacpo_orient() in one process, byte for
 # byte, for 1, 2 and 3 ranks (oversubscribed: more ranks than cores is fine),
-# and fails cleanly (a message and exit status 1 or 2 on every rank, no hang).
+# reads and writes PCD as well as PLY, and fails cleanly (a message and exit status 1 or 2 on every rank, no hang).
 #
 #   check_mpi.sh MAKE_SCENE ORIENT_MPI EVAL MPIEXEC WORKDIR
 set -euo pipefail
@@ -45,6 +45,16 @@ check_scene() { # name, make_scene args..., -- tool args...
 
 # a room with estimated normals, seed 3, 11 blocks over 3 ranks
 MAX=10 check_scene room -scene room -n 20000 -seed 4 -- -estimate -seed 3 -blocks 11
+# PCD out and in: PCL (the evaluator) reads the PCD written by 2 ranks to the
+# same score, and that PCD as input (normals re-estimated) gives the same bytes
+run 2 "$W/room.ply" "$W/room_np2.pcd" -q -estimate -seed 3 -blocks 11
+[ "$("$EVAL" "$W/room.ply" "$W/room_np2.pcd" -json | sed 's/"file":[^,]*,//')" = \
+  "$("$EVAL" "$W/room.ply" "$W/room_np2.ply" -json | sed 's/"file":[^,]*,//')" ] ||
+  fail "room: the PCD output scores differently from the PLY output"
+run 3 "$W/room_np2.pcd" "$W/room_from_pcd.ply" -q -estimate -seed 3 -blocks 11
+cmp "$W/room_np2.ply" "$W/room_from_pcd.ply" ||
+  fail "room: PCD input gives other normals than PLY input"
+echo "room: PCD output read by PCL to the same score, PCD input gives the same bytes"
 # two rooms (two components) with the file's normals as axes
 MAX=5 check_scene two_rooms -scene two_rooms -n 12000 -seed 2 -- -seed 5
 

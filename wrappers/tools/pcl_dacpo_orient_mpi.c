@@ -3,7 +3,7 @@
  * pcl_dacpo_orient_mpi: dacpo_orient() with its block and edge units spread
  * over MPI ranks (dacpo_advanced.h). Plain C; MPI only here, never in the core.
  *
- *   mpirun -np R pcl_dacpo_orient_mpi in.ply out.ply [-estimate] [-seed S]
+ *   mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] [-seed S]
  *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-report F] [-q]
  *
  * Rank 0 reads the cloud and runs stages 0-1 (k-NN graph, normals, blocks) and
@@ -20,9 +20,11 @@
  * What this does not do yet: rank 0 holds the whole cloud (the other ranks
  * hold only their units), reads it alone and writes the output alone.
  *
- * Output: binary PLY, float x y z nx ny nz, in input order. -report F writes
- * one JSON object per rank (wall seconds per phase, peak RSS, bytes sent and
- * received, units run).
+ * Input: PLY (ascii or binary) or PCD (ascii, binary or binary_compressed), by
+ * extension (wrappers/support/dacpo_pcd.h). Output: binary PLY (float x y z nx
+ * ny nz) or binary PCD (float x y z normal_x normal_y normal_z), by the
+ * output's extension, in input order. -report F writes one JSON object per
+ * rank (wall seconds per phase, peak RSS, bytes sent and received, units run).
  *
  * Exit status: 0 on success, 1 for bad arguments, 2 when reading, orienting or
  * writing fails (every rank exits with the same status; a unit that fails
@@ -33,7 +35,7 @@
 #include <dacpo/dacpo.h>
 #include <dacpo/dacpo_advanced.h>
 
-#include "dacpo_ply.h"
+#include "dacpo_pcd.h"
 #include <sys/resource.h>
 
 #include <errno.h>
@@ -142,11 +144,12 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
     }
   }
   if (!o->in || !o->out) {
-    snprintf(msg,
-             msg_size,
-             "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply out.ply [-estimate] "
-             "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
-             "[-report F] [-q]");
+    snprintf(
+        msg,
+        msg_size,
+        "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] "
+        "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
+        "[-report F] [-q]");
     return 0;
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
@@ -526,7 +529,7 @@ prepare(const options* o,
         dacpo_job** job)
 {
   char msg[512];
-  if (dacpo_ply_read(o->in, cloud, msg, sizeof(msg)) != DACPO_PLY_OK) {
+  if (dacpo_points_read(o->in, cloud, msg, sizeof(msg)) != DACPO_PLY_OK) {
     fprintf(stderr, "Error: %s\n", msg);
     return 0;
   }
@@ -654,13 +657,17 @@ write_output(const char* path, const dacpo_ply_cloud* cloud)
   int ok = tmp != NULL;
   if (ok) {
     snprintf(tmp, len, "%s.tmp%ld", path, (long)getpid());
-    ok = dacpo_ply_write(tmp,
-                         cloud->xyz,
-                         cloud->normals,
-                         cloud->n,
-                         "pcl_dacpo_orient_mpi",
-                         msg,
-                         sizeof(msg)) == DACPO_PLY_OK;
+    /* the format of the target's name, not of the temporary one */
+    int (*write)(
+        const char*, const float*, const float*, size_t, const char*, char*, size_t) =
+        dacpo_is_pcd_path(path) ? dacpo_pcd_write : dacpo_ply_write;
+    ok = write(tmp,
+               cloud->xyz,
+               cloud->normals,
+               cloud->n,
+               "pcl_dacpo_orient_mpi",
+               msg,
+               sizeof(msg)) == DACPO_PLY_OK;
     if (!ok)
       fprintf(stderr, "Error: %s\n", msg);
     else if (rename(tmp, path) != 0) {
@@ -681,10 +688,9 @@ print_help(void)
   dacpo_params d;
   dacpo_params_init(&d);
   printf(
-      "Orient the normals of a PLY point cloud with DACPO, its blocks and edges "
-      "spread\n"
-      "over MPI ranks; the output is byte-identical to one process.\n\n"
-      "Usage: mpirun -np R pcl_dacpo_orient_mpi in.ply out.ply [options]\n\n"
+      "Orient the normals of a PLY or PCD point cloud with DACPO, its blocks and\n"
+      "edges spread over MPI ranks; the output is byte-identical to one process.\n\n"
+      "Usage: mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [options]\n\n"
       "Options:\n"
       "  -estimate     estimate PCA normals even when the file has nx ny nz (without\n"
       "                them they are always estimated)\n"
@@ -699,9 +705,10 @@ print_help(void)
       "units,\n"
       "                peak RSS, MB sent and received\n"
       "  -q            no rank table on stdout\n\n"
-      "Output: binary PLY, float x y z nx ny nz, in input order. As root, Open MPI "
-      "needs\n"
-      "--allow-run-as-root (or OMPI_ALLOW_RUN_AS_ROOT=1 "
+      "Input: PLY (ascii or binary) or PCD (ascii, binary or binary_compressed), by\n"
+      "extension. Output: binary PLY (x y z nx ny nz) or binary PCD (x y z\n"
+      "normal_x normal_y normal_z) by the output's extension, in input order.\n"
+      "As root, Open MPI needs --allow-run-as-root (or OMPI_ALLOW_RUN_AS_ROOT=1\n"
       "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1).\n"
       "Exit status: 0 success, 1 bad arguments, 2 reading, orienting or writing "
       "failed.\n",
