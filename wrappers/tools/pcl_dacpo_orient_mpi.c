@@ -4,9 +4,12 @@
  * over MPI ranks (dacpo_advanced.h). Plain C; MPI only here, never in the core.
  *
  *   mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] [-seed S]
- *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-report F] [-q]
+ *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-serial_knn]
+ *          [-knn_halo H] [-report F] [-q]
  *
- * Rank 0 reads the cloud and runs stages 0-1 (k-NN graph, normals, blocks) and
+ * Rank 0 reads the cloud; the k-NN search of stage 0 is spread over the ranks
+ * (dacpo_mpi_knn.h: one slab per rank with a halo; -serial_knn: rank 0
+ * alone); rank 0 runs the rest of stages 0-1 (k-NN graph, normals, blocks) and
  * 5-6 (the 0-1 program, parts, global sign); the blocks (stages 2-3) and then
  * the edges (stage 4, VCR) are dealt out to all ranks, rank 0 included, by
  * estimated cost (a block: its own and ring points; an edge: the triangles of
@@ -18,7 +21,9 @@
  * dacpo_orient() itself, for comparison).
  *
  * What this does not do yet: rank 0 holds the whole cloud (the other ranks
- * hold only their units), reads it alone and writes the output alone.
+ * hold only their slab and their units), reads it alone, writes the output
+ * alone and runs stages 0-1 past the neighbour search (normals, graph,
+ * blocks) alone.
  *
  * Input: PLY (ascii or binary) or PCD (ascii, binary or binary_compressed), by
  * extension (wrappers/support/dacpo_pcd.h). Output: binary PLY (float x y z nx
@@ -35,10 +40,13 @@
 #include <dacpo/dacpo.h>
 #include <dacpo/dacpo_advanced.h>
 
+#include "dacpo_mpi_comm.h"
+#include "dacpo_mpi_knn.h"
 #include "dacpo_pcd.h"
 #include <sys/resource.h>
 
 #include <errno.h>
+#include <math.h>
 #include <mpi.h>
 #include <sched.h>
 #include <stdint.h>
@@ -54,7 +62,8 @@ typedef struct options {
   const char* in;
   const char* out;
   const char* report;
-  int estimate, whole, quiet;
+  int estimate, whole, quiet, serial_knn;
+  double knn_halo;
   dacpo_params p;
 } options;
 
@@ -62,9 +71,11 @@ typedef struct options {
 typedef struct rank_report {
   double wall[5]; /* read + stages 0-1, blocks, edges, solve + finish, write */
   double peak_rss_mb;
-  double sent_mb, received_mb;
+  dacpo_mpi_traffic traffic;
   double blocks, edges; /* units run here */
   double busy;          /* seconds in this rank's units */
+  double knn;           /* seconds in this rank's share of the k-NN search */
+  double knn_rounds;    /* halo widths the search tried (rank 0; 0: rank 0 alone) */
 } rank_report;
 
 static double
@@ -111,6 +122,16 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
       o->whole = 1;
     else if (!strcmp(a, "-q"))
       o->quiet = 1;
+    else if (!strcmp(a, "-serial_knn"))
+      o->serial_knn = 1;
+    else if (!strcmp(a, "-knn_halo") && has_value) {
+      char* end = NULL;
+      o->knn_halo = strtod(argv[++i], &end);
+      if (*end != '\0' || !(o->knn_halo > 0.0) || !isfinite(o->knn_halo)) {
+        snprintf(msg, msg_size, "-knn_halo needs a positive number, got %s", argv[i]);
+        return 0;
+      }
+    }
     else if (!strcmp(a, "-report") && has_value)
       o->report = argv[++i];
     else if (a[0] == '-' && has_value && parse_size(argv[i + 1], &v)) {
@@ -149,7 +170,7 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         msg_size,
         "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] "
         "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
-        "[-report F] [-q]");
+        "[-serial_knn] [-knn_halo H] [-report F] [-q]");
     return 0;
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
@@ -196,84 +217,6 @@ done:
   free(order);
   free(load);
   return owner;
-}
-
-/* Between two tests of a pending transfer: the first tests only yield the
- * core (a large message moves in fragments, and each fragment needs both
- * ends to call MPI: sleeping 1 ms between them made a 200K-point run 40 %
- * slower); then sleep, so that a rank waiting for a peer that computes does
- * not take the core from it (more ranks than cores). */
-static void
-pause_between_tests(unsigned* tries)
-{
-  if (++*tries < 20000)
-    sched_yield();
-  else {
-    const struct timespec ms = {0, 1000000};
-    nanosleep(&ms, NULL);
-  }
-}
-
-static void
-wait_quietly(MPI_Request* req)
-{
-  int done = 0;
-  unsigned tries = 0;
-  MPI_Test(req, &done, MPI_STATUS_IGNORE);
-  while (!done) {
-    pause_between_tests(&tries);
-    MPI_Test(req, &done, MPI_STATUS_IGNORE);
-  }
-}
-
-/* Receives one message of any size from `src` (MPI_ANY_SOURCE allowed) with
- * `tag`; *from gets the sender. */
-static void*
-recv_bytes(int src, int tag, size_t* size, int* from, rank_report* rep)
-{
-  int flag = 0;
-  MPI_Status st;
-  unsigned tries = 0;
-  MPI_Iprobe(src, tag, MPI_COMM_WORLD, &flag, &st);
-  while (!flag) {
-    pause_between_tests(&tries);
-    MPI_Iprobe(src, tag, MPI_COMM_WORLD, &flag, &st);
-  }
-  int count = 0;
-  MPI_Get_count(&st, MPI_BYTE, &count);
-  void* buf = malloc((size_t)count + 1);
-  MPI_Request req;
-  MPI_Irecv(buf, count, MPI_BYTE, st.MPI_SOURCE, tag, MPI_COMM_WORLD, &req);
-  wait_quietly(&req);
-  *size = (size_t)count;
-  if (from)
-    *from = st.MPI_SOURCE;
-  rep->received_mb += (double)count / 1048576.0;
-  return buf;
-}
-
-static void
-send_bytes(const void* buf, size_t size, int dst, int tag, rank_report* rep)
-{
-  MPI_Request req;
-  MPI_Isend(buf, (int)size, MPI_BYTE, dst, tag, MPI_COMM_WORLD, &req);
-  wait_quietly(&req);
-  rep->sent_mb += (double)size / 1048576.0;
-}
-
-/* A failure on any rank ends the run on every rank. The other ranks also wait
- * here through rank 0's stages 0-1: a blocking MPI_Allreduce would spin on a
- * core that rank 0's threads may need when ranks share cores (no gain could be
- * measured on 2 cores: rank 0's stages 0-1 of the 10M floor took 44-66 s over
- * runs with 1-4 ranks either way, run-to-run noise included). */
-static int
-all_ok(int ok)
-{
-  int all = 0;
-  MPI_Request req;
-  MPI_Iallreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &req);
-  wait_quietly(&req);
-  return all;
 }
 
 /* A unit's task and result on a rank that is not rank 0. */
@@ -399,7 +342,7 @@ deal_from_rank0(dacpo_job* job,
       ok = k->task(job, u, &task, &size, msg, msg_size) == DACPO_OK &&
            size <= (size_t)INT32_MAX;
       if (ok)
-        send_bytes(task, size, owner[u], k->tag, rep);
+        dacpo_mpi_send(task, size, owner[u], k->tag, &rep->traffic);
       dacpo_unit_bytes_free(task);
     }
   for (size_t u = 0; u < count && ok; ++u)
@@ -412,7 +355,8 @@ deal_from_rank0(dacpo_job* job,
   for (size_t u = 0; u < count && ok; ++u)
     if (owner[u] != 0) {
       size_t size = 0;
-      void* answer = recv_bytes(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, rep);
+      void* answer =
+          dacpo_mpi_recv(MPI_ANY_SOURCE, TAG_RESULT, &size, NULL, &rep->traffic);
       ok = k->put(job, answer, size, msg, msg_size) == DACPO_OK;
       free(answer);
     }
@@ -436,7 +380,7 @@ work_for_rank0(const unit_kind* k,
   int ok = m != NULL;
   for (size_t u = 0; u < count && ok; ++u)
     if (owner[u] == rank)
-      m[u].task = recv_bytes(0, k->tag, &m[u].task_size, NULL, rep);
+      m[u].task = dacpo_mpi_recv(0, k->tag, &m[u].task_size, NULL, &rep->traffic);
   for (size_t u = 0; u < count && ok; ++u)
     if (owner[u] == rank) {
       const double t = now();
@@ -454,7 +398,7 @@ work_for_rank0(const unit_kind* k,
       /* MPI counts are int: a block of some 40M points would not fit */
       ok = m[u].res_size <= (size_t)INT32_MAX;
       if (ok)
-        send_bytes(m[u].res, m[u].res_size, 0, TAG_RESULT, rep);
+        dacpo_mpi_send(m[u].res, m[u].res_size, 0, TAG_RESULT, &rep->traffic);
       else
         snprintf(msg,
                  msg_size,
@@ -512,7 +456,7 @@ share_costs(dacpo_job* job, int rank, int edges, size_t* count)
                 : dacpo_job_block_task(job, u, NULL, &size, NULL, 0)) == DACPO_OK;
     cost[u] = (double)size;
   }
-  if (!all_ok(ok)) {
+  if (!dacpo_mpi_all_ok(ok)) {
     free(cost);
     return NULL;
   }
@@ -520,13 +464,9 @@ share_costs(dacpo_job* job, int rank, int edges, size_t* count)
   return cost;
 }
 
-/* Rank 0: read the cloud, stages 0-1. */
+/* Rank 0: read the cloud; the run's parameters. */
 static int
-prepare(const options* o,
-        dacpo_ctx* ctx,
-        dacpo_ply_cloud* cloud,
-        dacpo_params* p,
-        dacpo_job** job)
+read_input(const options* o, dacpo_ply_cloud* cloud, dacpo_params* p)
 {
   char msg[512];
   if (dacpo_points_read(o->in, cloud, msg, sizeof(msg)) != DACPO_PLY_OK) {
@@ -540,10 +480,45 @@ prepare(const options* o,
     if (!cloud->normals)
       return 0;
   }
-  if (o->whole)
-    return 1;
-  if (dacpo_job_create(ctx, p, NULL, NULL, cloud->xyz, cloud->normals, cloud->n, job) !=
-      DACPO_OK) {
+  return 1;
+}
+
+/* The nearest per point the distributed search gathers: stage 0's largest k,
+ * the point itself, and 4 for exact duplicates (with more, dacpo_job_create
+ * asks for more than the table holds and rank 0 searches alone). */
+static size_t
+table_width(const dacpo_params* p, size_t n)
+{
+  size_t k = p->k;
+  if (p->estimate_normals && p->normal_k > k)
+    k = p->normal_k;
+  return k + 5 < n ? k + 5 : n;
+}
+
+/* Rank 0: stages 0-1, over the gathered rows when there are any. */
+static int
+create_job(dacpo_ctx* ctx,
+           const dacpo_params* p,
+           dacpo_ply_cloud* cloud,
+           dacpo_knn_table* table,
+           dacpo_job** job)
+{
+  dacpo_search search = {dacpo_knn_table_search, table};
+  dacpo_status st = dacpo_job_create(ctx,
+                                     p,
+                                     table->ids ? &search : NULL,
+                                     NULL,
+                                     cloud->xyz,
+                                     cloud->normals,
+                                     cloud->n,
+                                     job);
+  if (st == DACPO_ERR_NEIGHBOR_SEARCH && table->ids) {
+    fprintf(stderr, "Note: %s: rank 0 searches alone\n", dacpo_ctx_last_error(ctx));
+    st =
+        dacpo_job_create(ctx, p, NULL, NULL, cloud->xyz, cloud->normals, cloud->n, job);
+  }
+  dacpo_knn_table_free(table);
+  if (st != DACPO_OK) {
     fprintf(stderr, "Error: %s\n", dacpo_ctx_last_error(ctx));
     return 0;
   }
@@ -557,44 +532,50 @@ write_report(const options* o, const rank_report* all, int ranks)
   if (o->report && !f)
     fprintf(stderr, "Error: cannot write %s: %s\n", o->report, strerror(errno));
   if (!o->quiet)
-    printf("rank  read+0-1  blocks   edges  solve  write   busy  peak RSS MB  sent MB  "
-           "recv MB  blocks edges\n");
+    printf("rank  read+0-1    knn  blocks   edges  solve  write   busy  peak RSS MB  "
+           "sent MB  recv MB  blocks edges\n");
   for (int r = 0; r < ranks; ++r) {
     const rank_report* x = all + r;
     if (!o->quiet)
-      printf("%4d %9.2f %7.2f %7.2f %6.2f %6.2f %6.2f %12.1f %8.1f %8.1f %7.0f %5.0f\n",
+      printf("%4d %9.2f %6.2f %7.2f %7.2f %6.2f %6.2f %6.2f %12.1f %8.1f %8.1f %7.0f "
+             "%5.0f\n",
              r,
              x->wall[0],
+             x->knn,
              x->wall[1],
              x->wall[2],
              x->wall[3],
              x->wall[4],
              x->busy,
              x->peak_rss_mb,
-             x->sent_mb,
-             x->received_mb,
+             x->traffic.sent_mb,
+             x->traffic.received_mb,
              x->blocks,
              x->edges);
     if (f)
-      fprintf(f,
-              "{\"rank\": %d, \"ranks\": %d, \"read_stages01_s\": %.3f, \"blocks_s\": "
-              "%.3f, \"edges_s\": %.3f, \"solve_s\": %.3f, \"write_s\": %.3f, "
-              "\"busy_s\": %.3f, \"peak_rss_mb\": %.1f, \"sent_mb\": %.3f, "
-              "\"received_mb\": %.3f, "
-              "\"blocks\": %.0f, \"edges\": %.0f}\n",
-              r,
-              ranks,
-              x->wall[0],
-              x->wall[1],
-              x->wall[2],
-              x->wall[3],
-              x->wall[4],
-              x->busy,
-              x->peak_rss_mb,
-              x->sent_mb,
-              x->received_mb,
-              x->blocks,
-              x->edges);
+      fprintf(
+          f,
+          "{\"rank\": %d, \"ranks\": %d, \"read_stages01_s\": %.3f, \"knn_s\": %.3f, "
+          "\"knn_rounds\": %.0f, \"blocks_s\": "
+          "%.3f, \"edges_s\": %.3f, \"solve_s\": %.3f, \"write_s\": %.3f, "
+          "\"busy_s\": %.3f, \"peak_rss_mb\": %.1f, \"sent_mb\": %.3f, "
+          "\"received_mb\": %.3f, "
+          "\"blocks\": %.0f, \"edges\": %.0f}\n",
+          r,
+          ranks,
+          x->wall[0],
+          x->knn,
+          x->knn_rounds,
+          x->wall[1],
+          x->wall[2],
+          x->wall[3],
+          x->wall[4],
+          x->busy,
+          x->peak_rss_mb,
+          x->traffic.sent_mb,
+          x->traffic.received_mb,
+          x->blocks,
+          x->edges);
   }
   if (f)
     fclose(f);
@@ -618,19 +599,21 @@ orient(const options* o,
                  DACPO_OK;
     if (!ok)
       fprintf(stderr, "Error: %s\n", dacpo_ctx_last_error(ctx));
-    return all_ok(ok);
+    return dacpo_mpi_all_ok(ok);
   }
   size_t nb = 0, ne = 0;
   double* bcost = share_costs(job, rank, 0, &nb);
   int* bowner = bcost ? deal(bcost, nb, ranks) : NULL;
-  int ok = all_ok(bowner != NULL) &&
-           all_ok(run_units(job, &blocks_kind, nb, bowner, rank, rep, &rep->blocks));
+  int ok = dacpo_mpi_all_ok(bowner != NULL) &&
+           dacpo_mpi_all_ok(
+               run_units(job, &blocks_kind, nb, bowner, rank, rep, &rep->blocks));
   rep->wall[1] = now() - *t;
   *t = now();
   double* ecost = ok ? share_costs(job, rank, 1, &ne) : NULL;
   int* eowner = ecost ? deal(ecost, ne, ranks) : NULL;
-  ok = ok && all_ok(eowner != NULL) &&
-       all_ok(run_units(job, &edges_kind, ne, eowner, rank, rep, &rep->edges));
+  ok =
+      ok && dacpo_mpi_all_ok(eowner != NULL) &&
+      dacpo_mpi_all_ok(run_units(job, &edges_kind, ne, eowner, rank, rep, &rep->edges));
   rep->wall[2] = now() - *t;
   *t = now();
   if (ok && rank == 0) {
@@ -643,7 +626,7 @@ orient(const options* o,
   free(ecost);
   free(bowner);
   free(eowner);
-  return all_ok(ok);
+  return dacpo_mpi_all_ok(ok);
 }
 
 /* The output goes to a file beside the target first and is renamed over it
@@ -701,6 +684,11 @@ print_help(void)
       "  -threads T    threads of rank 0's stages 0-1 (default: 1); the units run one\n"
       "                per rank\n"
       "  -whole        rank 0 runs dacpo_orient() alone (for comparison)\n"
+      "  -serial_knn   rank 0 runs stage 0's neighbour search alone (default: one\n"
+      "                slab of the cloud per rank, with a halo)\n"
+      "  -knn_halo H   the search's first halo width, in the cloud's units (default:\n"
+      "                from its box and size; rows it does not cover ask again 4x "
+      "wider)\n"
       "  -report F     one JSON line per rank: wall time per phase, time in its "
       "units,\n"
       "                peak RSS, MB sent and received\n"
@@ -748,8 +736,24 @@ main(int argc, char** argv)
   dacpo_params p = o.p;
   int ok = 1;
   if (rank == 0)
-    ok = dacpo_ctx_create(&ctx) == DACPO_OK && prepare(&o, ctx, &cloud, &p, &job);
-  ok = all_ok(ok);
+    ok = dacpo_ctx_create(&ctx) == DACPO_OK && read_input(&o, &cloud, &p);
+  ok = dacpo_mpi_all_ok(ok);
+  dacpo_knn_table table;
+  memset(&table, 0, sizeof(table));
+  if (ok && !o.whole && !o.serial_knn)
+    ok = dacpo_mpi_knn(cloud.xyz,
+                       cloud.n,
+                       table_width(&p, cloud.n),
+                       rank,
+                       ranks,
+                       o.knn_halo,
+                       &table,
+                       &rep.knn,
+                       &rep.traffic);
+  rep.knn_rounds = (double)table.rounds;
+  if (ok && rank == 0 && !o.whole)
+    ok = create_job(ctx, &p, &cloud, &table, &job);
+  ok = dacpo_mpi_all_ok(ok);
   rep.wall[0] = now() - t;
   t = now();
   ok = ok && orient(&o, ctx, job, &cloud, &p, rank, ranks, &rep, &t);
@@ -757,7 +761,7 @@ main(int argc, char** argv)
   t = now();
   if (ok && rank == 0)
     ok = write_output(o.out, &cloud);
-  ok = all_ok(ok);
+  ok = dacpo_mpi_all_ok(ok);
   rep.wall[4] = now() - t;
   rep.peak_rss_mb = peak_rss_mb();
   rank_report* all = rank == 0 ? calloc((size_t)ranks, sizeof(rank_report)) : NULL;

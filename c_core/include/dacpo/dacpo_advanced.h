@@ -151,6 +151,38 @@ dacpo_job_put_edge(dacpo_job* job,
                    char* msg,
                    size_t msg_size);
 
+/**
+ * \brief Stage 0's neighbour search for one region of a cloud (a slab of a
+ *  spatial split), so that processes can share it: the k nearest of every own
+ *  point among the region's n points (its own points and a halo around them).
+ *
+ * xyz: 3n floats in the order of the caller's global point numbers (ascending),
+ * so that ties go to the lower number as in a search over the whole cloud;
+ * own[i] != 0 marks the points that want a row (m of them). For the j-th own
+ * point: nbr[j k + t] (region indices, the point itself and its exact
+ * duplicates included, nearest first, ties to the lower index, -1 past the
+ * region's size) and sqd[j k + t] (squared distances, +inf for -1); complete[j]
+ * = 1 when the row is certain: box_lo / box_hi bound the space in which the
+ * region holds every point of the cloud (+-HUGE_VAL: unbounded), and the ball
+ * through the k-th neighbour lies inside it. Rows of complete points joined
+ * over regions equal the whole cloud's k nearest; for the others widen the halo
+ * and ask again. Serve the joined rows to dacpo_job_create() through a
+ * dacpo_search (pcl_dacpo_orient_mpi does). Thread-safe, no job needed.
+ * Errors: INVALID_ARGUMENT (NULL arrays, k = 0), NONFINITE_INPUT, OUT_OF_MEMORY.
+ */
+DACPO_API dacpo_status
+dacpo_region_knn(const float* xyz,
+                 const uint8_t* own,
+                 size_t n,
+                 size_t k,
+                 const double box_lo[3],
+                 const double box_hi[3],
+                 int32_t* nbr,
+                 float* sqd,
+                 uint8_t* complete,
+                 char* msg,
+                 size_t msg_size);
+
 /** \brief Frees bytes a task or result call returned. NULL-safe. */
 DACPO_API void
 dacpo_unit_bytes_free(void* bytes);
