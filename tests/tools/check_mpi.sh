@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The MPI tool gives the normals of dacpo_orient() in one process, byte for
 # byte, for 1, 2 and 3 ranks (oversubscribed: more ranks than cores is fine),
-# with stage 0's neighbour search spread over the ranks or not, reads and
+# with stage 0's neighbour search on rank 0 or spread over the ranks, reads and
 # writes PCD as well as PLY, and fails cleanly (a message and exit status 1 or 2 on every rank, no hang).
 #
 #   check_mpi.sh MAKE_SCENE ORIENT_MPI EVAL MPIEXEC WORKDIR
@@ -46,17 +46,20 @@ check_scene() { # name, make_scene args..., -- tool args...
 
 # a room with estimated normals, seed 3, 11 blocks over 3 ranks
 MAX=10 check_scene room -scene room -n 20000 -seed 4 -- -estimate -seed 3 -blocks 11
-# the distributed neighbour search: a first halo far too thin is widened
-# round by round (every rank's rows checked), rank 0 alone, and a cloud of
+# the spread neighbour search (-spread_knn): 2 and 3 ranks, a first halo far
+# too thin, widened round by round (every rank's rows checked), and a cloud of
 # six copies of every point (more duplicates than the gathered rows hold: rank
 # 0 searches alone, with a note) all give the bytes of one process
-args=(-q -estimate -seed 3 -blocks 11)
+args=(-q -estimate -seed 3 -blocks 11 -spread_knn)
+for np in 2 3; do
+  run "$np" "$W/room.ply" "$W/room_spread$np.ply" "${args[@]}"
+  cmp "$W/room_whole.ply" "$W/room_spread$np.ply" ||
+    fail "room: -spread_knn on $np ranks changes the normals"
+done
 run 3 "$W/room.ply" "$W/room_halo.ply" "${args[@]}" -knn_halo 0.0001 -report "$W/halo.json"
 cmp "$W/room_whole.ply" "$W/room_halo.ply" || fail "room: a thin first halo changes the normals"
 rounds=$(sed -n 's/.*"knn_rounds": \([0-9]*\).*/\1/p' "$W/halo.json" | head -1)
 [ "${rounds:-0}" -ge 3 ] || fail "room: a thin first halo took ${rounds:-?} rounds, not >= 3"
-run 2 "$W/room.ply" "$W/room_serial.ply" "${args[@]}" -serial_knn
-cmp "$W/room_whole.ply" "$W/room_serial.ply" || fail "room: -serial_knn changes the normals"
 hl=$(grep -a -b -m1 "^end_header" "$W/room.ply" | cut -d: -f1)
 hl=$((hl + 11))
 { head -c "$hl" "$W/room.ply" | sed 's/^element vertex 20000$/element vertex 120000/'
@@ -65,7 +68,7 @@ run 1 "$W/dup.ply" "$W/dup_whole.ply" "${args[@]}" -whole
 out=$(run 2 "$W/dup.ply" "$W/dup_np2.ply" "${args[@]}" 2>&1)
 cmp "$W/dup_whole.ply" "$W/dup_np2.ply" || fail "duplicates: 2 ranks differ from one process"
 grep -q "rank 0 searches alone" <<< "$out" || fail "duplicates: no note of the fallback: $out"
-echo "room: halo widened over $rounds rounds, -serial_knn and a 6-fold duplicated cloud: same bytes"
+echo "room: -spread_knn on 2 and 3 ranks, a halo widened over $rounds rounds and a 6-fold duplicated cloud: same bytes"
 # PCD out and in: PCL (the evaluator) reads the PCD written by 2 ranks to the
 # same score, and that PCD as input (normals re-estimated) gives the same bytes
 run 2 "$W/room.ply" "$W/room_np2.pcd" -q -estimate -seed 3 -blocks 11
@@ -101,7 +104,7 @@ set -e
 [ "$st" -ne 0 ] && grep -q "cannot open" <<< "$out" || fail "unwritable output: status $st: $out"
 # help: every option named, status 0
 out=$(run 2 -h)
-for opt in -estimate -seed -blocks -k -normal_k -threads -whole -serial_knn -knn_halo \
+for opt in -estimate -seed -blocks -k -normal_k -threads -whole -spread_knn -knn_halo \
     -report -q; do
   grep -q -- " $opt " <<< "$out" || fail "help does not name $opt"
 done

@@ -4,13 +4,13 @@
  * over MPI ranks (dacpo_advanced.h). Plain C; MPI only here, never in the core.
  *
  *   mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] [-seed S]
- *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-serial_knn]
+ *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-spread_knn]
  *          [-knn_halo H] [-report F] [-q]
  *
- * Rank 0 reads the cloud; the k-NN search of stage 0 is spread over the ranks
- * (dacpo_mpi_knn.h: one slab per rank with a halo; -serial_knn: rank 0
- * alone); rank 0 runs the rest of stages 0-1 (k-NN graph, normals, blocks) and
- * 5-6 (the 0-1 program, parts, global sign); the blocks (stages 2-3) and then
+ * Rank 0 reads the cloud and runs stages 0-1 (k-NN graph, normals, blocks;
+ * -spread_knn: the k-NN search spread over the ranks, dacpo_mpi_knn.h: one
+ * slab per rank with a halo) and 5-6 (the 0-1 program, parts, global sign);
+ * the blocks (stages 2-3) and then
  * the edges (stage 4, VCR) are dealt out to all ranks, rank 0 included, by
  * estimated cost (a block: its own and ring points; an edge: the triangles of
  * its two meshes), longest first to the least loaded rank. A block travels as
@@ -21,9 +21,9 @@
  * dacpo_orient() itself, for comparison).
  *
  * What this does not do yet: rank 0 holds the whole cloud (the other ranks
- * hold only their slab and their units), reads it alone, writes the output
- * alone and runs stages 0-1 past the neighbour search (normals, graph,
- * blocks) alone.
+ * hold only their units, and their slab with -spread_knn), reads it alone,
+ * writes the output alone and runs stages 0-1 past the neighbour search
+ * (normals, graph, blocks) alone.
  *
  * Input: PLY (ascii or binary) or PCD (ascii, binary or binary_compressed), by
  * extension (wrappers/support/dacpo_pcd.h). Output: binary PLY (float x y z nx
@@ -62,7 +62,7 @@ typedef struct options {
   const char* in;
   const char* out;
   const char* report;
-  int estimate, whole, quiet, serial_knn;
+  int estimate, whole, quiet, spread_knn;
   double knn_halo;
   dacpo_params p;
 } options;
@@ -122,8 +122,8 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
       o->whole = 1;
     else if (!strcmp(a, "-q"))
       o->quiet = 1;
-    else if (!strcmp(a, "-serial_knn"))
-      o->serial_knn = 1;
+    else if (!strcmp(a, "-spread_knn"))
+      o->spread_knn = 1;
     else if (!strcmp(a, "-knn_halo") && has_value) {
       char* end = NULL;
       o->knn_halo = strtod(argv[++i], &end);
@@ -170,7 +170,7 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         msg_size,
         "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] "
         "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
-        "[-serial_knn] [-knn_halo H] [-report F] [-q]");
+        "[-spread_knn] [-knn_halo H] [-report F] [-q]");
     return 0;
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
@@ -684,9 +684,10 @@ print_help(void)
       "  -threads T    threads of rank 0's stages 0-1 (default: 1); the units run one\n"
       "                per rank\n"
       "  -whole        rank 0 runs dacpo_orient() alone (for comparison)\n"
-      "  -serial_knn   rank 0 runs stage 0's neighbour search alone (default: one\n"
-      "                slab of the cloud per rank, with a halo)\n"
-      "  -knn_halo H   the search's first halo width, in the cloud's units (default:\n"
+      "  -spread_knn   stage 0's neighbour search spread over the ranks (one slab of\n"
+      "                the cloud per rank, with a halo); default: rank 0 alone with\n"
+      "                -threads (10M points, 2 cores: 42 s alone, 60 s spread)\n"
+      "  -knn_halo H   -spread_knn's first halo width, in the cloud's units (default:\n"
       "                from its box and size; rows it does not cover ask again 4x "
       "wider)\n"
       "  -report F     one JSON line per rank: wall time per phase, time in its "
@@ -740,7 +741,7 @@ main(int argc, char** argv)
   ok = dacpo_mpi_all_ok(ok);
   dacpo_knn_table table;
   memset(&table, 0, sizeof(table));
-  if (ok && !o.whole && !o.serial_knn)
+  if (ok && !o.whole && o.spread_knn)
     ok = dacpo_mpi_knn(cloud.xyz,
                        cloud.n,
                        table_width(&p, cloud.n),
