@@ -255,6 +255,9 @@ TEST(DacpoPcd, BadFilesGiveErrorsNotCrashes)
            std::string(64, 'x'),
        "truncated: 4000000000 points"},
       {good + "DATA ascii\n1 2 3\n4 five 6\n", "'five' is not a number"},
+      {good + "DATA ascii\n1 2 3\n4 5 6 7\n", "values after the last of 2 points"},
+      {good + "DATA ascii\n1 2 3\n4 5 " + std::string(200, '6') + "\n",
+       "is not a number"},
       {good + "DATA gzip\n", "unknown DATA 'gzip'"},
       {std::string(kHead3) +
            "FIELDS x y\nSIZE 4 4\nTYPE F F\nPOINTS 1\nDATA ascii\n1 2\n",

@@ -436,18 +436,24 @@ read_ascii(FILE* fp,
             err, errlen, "'%s' is truncated: %zu of %zu points", path, i, h->points);
         return DACPO_PLY_ERR_FORMAT;
       }
+      const int after = fgetc(fp); /* a word longer than the buffer is no number */
       char* end = NULL;
       const float x = strtof(word, &end);
-      if (*end != '\0') {
+      if (*end != '\0' || (after != EOF && !isspace(after))) {
         dacpo_support_err(
             err, errlen, "'%s': point %zu: '%s' is not a number", path, i, word);
         return DACPO_PLY_ERR_FORMAT;
       }
       for (int k = 0; k < 6; ++k)
-        if (idx[k] >= 0 && first[idx[k]] == v) {
+        if (idx[k] >= 0 && first[idx[k]] == v)
           store(out, i, k, x);
-        }
     }
+  }
+  char word[16]; /* a value left over: some line had one too many */
+  if (fscanf(fp, "%15s", word) == 1) {
+    dacpo_support_err(
+        err, errlen, "'%s': values after the last of %zu points", path, h->points);
+    return DACPO_PLY_ERR_FORMAT;
   }
   return DACPO_PLY_OK;
 }
