@@ -35,7 +35,7 @@
  * writing fails (every rank exits with the same status; a unit that fails
  * during the exchange stops all ranks with MPI_Abort).
  */
-#define _POSIX_C_SOURCE 200809L /* clock_gettime, nanosleep */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
 
 #include <dacpo/dacpo.h>
 #include <dacpo/dacpo_advanced.h>
@@ -48,7 +48,6 @@
 #include <errno.h>
 #include <math.h>
 #include <mpi.h>
-#include <sched.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
