@@ -101,6 +101,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
   p->dipole_c_thin = 4.0;
+  p->normal_weight = 0.0;
 }
 
 static dacpo_status
@@ -230,6 +231,11 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_two_sheet must be finite and >= 0 (got %g)",
                      p->dipole_two_sheet);
+  if (!(p->normal_weight >= 0.0) || !isfinite(p->normal_weight))
+    return bad_field(message,
+                     size,
+                     "normal_weight must be finite and >= 0 (got %g)",
+                     p->normal_weight);
   if (!(p->dipole_c_thin >= 0.0) || !isfinite(p->dipole_c_thin))
     return bad_field(message,
                      size,

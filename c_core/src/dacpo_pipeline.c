@@ -165,8 +165,14 @@ estimate_normals(run_state* s, dacpo_err* err)
   s->curvature = dacpo_malloc_array(n, sizeof(float));
   if (!s->curvature)
     return DACPO_OOM(err);
-  return dacpo_normals_pca(
-      &s->cloud, &s->knn, nk, s->p.num_threads, s->cloud.nrm, s->curvature, err);
+  return dacpo_normals_pca_weighted(&s->cloud,
+                                    &s->knn,
+                                    nk,
+                                    s->p.normal_weight,
+                                    s->p.num_threads,
+                                    s->cloud.nrm,
+                                    s->curvature,
+                                    err);
 }
 
 /* ---- stages 2-3: one block at a time ----------------------------------- */

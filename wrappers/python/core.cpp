@@ -53,6 +53,7 @@ defaultParams()
   d["dipole_sides"] = p.dipole_sides;
   d["cue_anchor"] = p.cue_anchor;
   d["dipole_c_thin"] = p.dipole_c_thin;
+  d["normal_weight"] = p.normal_weight;
   d["vcr_image_size"] = p.vcr_image_size;
   d["vcr_views"] = p.vcr_views;
   d["vcr_perspective"] = p.vcr_perspective != 0;
@@ -100,6 +101,7 @@ toParams(const py::dict& d)
   p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
   p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
   p.dipole_c_thin = get<double>(d, "dipole_c_thin", p.dipole_c_thin);
+  p.normal_weight = get<double>(d, "normal_weight", p.normal_weight);
   p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
   p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
   p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;

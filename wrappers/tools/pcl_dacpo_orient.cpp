@@ -156,6 +156,13 @@ const OptionSpec kOptions[] = {
      "neighbours of PCA normals when estimated",
      showNumber<size_t, &dacpo_params::normal_k>,
      setUnsigned<size_t, &dacpo_params::normal_k>},
+    {"-normal_weight",
+     "X",
+     "estimated normals: neighbours weigh exp(-d^2/h^2), h = X x the\n"
+     "distance of the middle one of normal_k; 0 = unweighted (1.5\n"
+     "helps rooms with thin furniture)",
+     showNumber<double, &dacpo_params::normal_weight>,
+     setDouble<&dacpo_params::normal_weight>},
     {"-estimate",
      nullptr,
      "estimate PCA normals even if the input has normal_x/y/z\n"

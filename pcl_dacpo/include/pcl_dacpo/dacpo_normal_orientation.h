@@ -204,6 +204,21 @@ public:
     return params_.normal_k;
   }
 
+  /** \brief Estimated normals: neighbours weigh exp(-d^2 / h^2) in the PCA, h =
+   *  weight x the distance of the middle one; 0 = unweighted (default). 1.5
+   *  helps rooms with thin furniture (README); see dacpo_params.normal_weight. */
+  void
+  setNormalWeight(double weight)
+  {
+    params_.normal_weight = weight;
+  }
+  /** \brief See setNormalWeight(). */
+  double
+  getNormalWeight() const
+  {
+    return params_.normal_weight;
+  }
+
   /** \brief Target number of blocks; 0 = automatic, n/1250 in [1, 200] (default 0). */
   void
   setNumberOfBlocks(std::size_t num_blocks)
