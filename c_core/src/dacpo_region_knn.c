@@ -37,7 +37,7 @@ region_knn(const float* xyz,
            dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && own && nbr && sqd && complete && box_lo && box_hi && k > 0,
+              xyz && own && nbr && complete && box_lo && box_hi && k > 0,
               DACPO_ERR_INVALID_ARGUMENT,
               "region k-NN: NULL array or k = 0");
   DACPO_CHECK(err,
@@ -68,10 +68,11 @@ region_knn(const float* xyz,
       continue;
     const size_t found = dacpo_kdtree_knn(tree, p + 3 * i, k, idx, d2);
     int32_t* r = nbr + row * k;
-    float* s = sqd + row * k;
+    float* s = sqd ? sqd + row * k : NULL;
     for (size_t t = 0; t < k; ++t) {
       r[t] = t < found ? idx[t] : -1;
-      s[t] = t < found ? (float)d2[t] : INFINITY;
+      if (s)
+        s[t] = t < found ? (float)d2[t] : INFINITY;
     }
     /* the ball through the k-th neighbour (all of space if there are fewer
      * than k points) must lie inside the box the region covers completely */

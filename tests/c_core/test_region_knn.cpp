@@ -155,6 +155,15 @@ TEST(DacpoRegionKnn, FewerPointsThanKAndBadInput)
   ASSERT_EQ(dacpo_region_knn(xyz, own, 3, 2, lo, hi, nbr, sqd, complete, msg, 256),
             DACPO_OK);
   EXPECT_EQ(complete[0], 1);
+  // without distances: the same rows and flags
+  int32_t rows[4];
+  uint8_t flags[2];
+  ASSERT_EQ(dacpo_region_knn(xyz, own, 3, 2, lo, hi, rows, nullptr, flags, msg, 256),
+            DACPO_OK);
+  for (int t = 0; t < 4; ++t)
+    EXPECT_EQ(rows[t], nbr[t]) << t;
+  EXPECT_EQ(flags[0], complete[0]);
+  EXPECT_EQ(flags[1], complete[1]);
 
   EXPECT_EQ(dacpo_region_knn(xyz, own, 3, 0, lo, hi, nbr, sqd, complete, msg, 256),
             DACPO_ERR_INVALID_ARGUMENT);

@@ -166,15 +166,14 @@ answer_region(
   *size = sizeof(uint64_t) + m * rec;
   unsigned char* out = malloc(*size);
   int32_t* nbr = malloc((m ? m : 1) * w * sizeof(int32_t));
-  float* sqd = malloc((m ? m : 1) * w * sizeof(float));
   uint8_t* complete = malloc(m ? m : 1);
-  if (!out || !nbr || !sqd || !complete) {
+  if (!out || !nbr || !complete) {
     snprintf(msg, msg_size, "distributed k-NN: out of memory");
     free(out);
     out = NULL;
   }
   else if (dacpo_region_knn(
-               p, own, n, w, hd.lo, hd.hi, nbr, sqd, complete, msg, msg_size) !=
+               p, own, n, w, hd.lo, hd.hi, nbr, NULL, complete, msg, msg_size) !=
            DACPO_OK) {
     free(out);
     out = NULL;
@@ -200,7 +199,6 @@ answer_region(
     }
   }
   free(nbr);
-  free(sqd);
   free(complete);
   return out;
 }

@@ -161,14 +161,16 @@ dacpo_job_put_edge(dacpo_job* job,
  * own[i] != 0 marks the points that want a row (m of them). For the j-th own
  * point: nbr[j k + t] (region indices, the point itself and its exact
  * duplicates included, nearest first, ties to the lower index, -1 past the
- * region's size) and sqd[j k + t] (squared distances, +inf for -1); complete[j]
+ * region's size) and, unless sqd is NULL, sqd[j k + t] (squared distances,
+ * +inf for -1); complete[j]
  * = 1 when the row is certain: box_lo / box_hi bound the space in which the
  * region holds every point of the cloud (+-HUGE_VAL: unbounded), and the ball
  * through the k-th neighbour lies inside it. Rows of complete points joined
  * over regions equal the whole cloud's k nearest; for the others widen the halo
  * and ask again. Serve the joined rows to dacpo_job_create() through a
  * dacpo_search (pcl_dacpo_orient_mpi does). Thread-safe, no job needed.
- * Errors: INVALID_ARGUMENT (NULL arrays, k = 0), NONFINITE_INPUT, OUT_OF_MEMORY.
+ * Errors: INVALID_ARGUMENT (NULL arrays other than sqd, k = 0), NONFINITE_INPUT,
+ * OUT_OF_MEMORY.
  */
 DACPO_API dacpo_status
 dacpo_region_knn(const float* xyz,
