@@ -102,6 +102,7 @@ dacpo_params_init(dacpo_params* p)
   p->cue_anchor = 1.0;
   p->dipole_c_thin = 4.0;
   p->normal_weight = 0.0;
+  p->adaptive_normals = 1;
 }
 
 static dacpo_status
@@ -236,6 +237,11 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "normal_weight must be finite and >= 0 (got %g)",
                      p->normal_weight);
+  if (p->adaptive_normals != 0 && p->adaptive_normals != 1)
+    return bad_field(message,
+                     size,
+                     "adaptive_normals must be 0 or 1 (got %d)",
+                     p->adaptive_normals);
   if (!(p->dipole_c_thin >= 0.0) || !isfinite(p->dipole_c_thin))
     return bad_field(message,
                      size,

@@ -78,7 +78,9 @@ jacobi3(double a[3][3], double w[3], double v[3][3])
     w[i] = a[i][i];
 }
 
-/* PCA axis and surface variation of one neighbourhood. */
+/* PCA axis and surface variation of one neighbourhood; elong (may be NULL)
+ * gets l1 / l2, the middle over the largest eigenvalue (near 0: the
+ * neighbours lie along a line or a narrow strip). */
 static void
 pca_point(const dacpo_cloud* cloud,
           const dacpo_knn_graph* g,
@@ -86,7 +88,8 @@ pca_point(const dacpo_cloud* cloud,
           double weight,
           size_t i,
           double nrm[3],
-          double* curv)
+          double* curv,
+          double* elong)
 {
   const double* xyz = cloud->xyz;
   const int32_t* row = g->idx + i * g->k;
@@ -169,6 +172,49 @@ pca_point(const dacpo_cloud* cloud,
     trace += l[d];
   }
   *curv = trace > 0.0 ? l[lo] / trace : 0.0;
+  if (elong) {
+    const int hi = l[(lo + 1) % 3] >= l[(lo + 2) % 3] ? (lo + 1) % 3 : (lo + 2) % 3;
+    const int mid = 3 - lo - hi;
+    *elong = l[hi] > 0.0 ? l[mid] / l[hi] : 0.0;
+  }
+}
+
+/* Adaptive scale: per point the neighbourhood among 3/4, 1 and 3/2 x normal_k
+ * with the lowest surface variation l0 / (l0 + l1 + l2) (Pauly et al. 2002:
+ * the scale at which the points look most like one plane). At 16 neighbours a
+ * sparse room's thin parts and corners mix two faces (the smaller scale is
+ * flatter there), noise is averaged better by the larger one. A scale other
+ * than normal_k must also see a neighbourhood that is not a strip (l1 / l2 >=
+ * ADAPTIVE_MIN_SPREAD): single depth frames break into flat depth-quantisation
+ * terraces whose narrow strips look perfectly planar with the wrong axis. */
+#define ADAPTIVE_MIN_SPREAD 0.3
+
+static void
+pca_point_adaptive(const dacpo_cloud* cloud,
+                   const dacpo_knn_graph* g,
+                   size_t normal_k,
+                   double weight,
+                   size_t i,
+                   double nrm[3],
+                   double* curv)
+{
+  size_t lo_k = (3 * normal_k + 2) / 4, hi_k = (3 * normal_k + 1) / 2;
+  if (lo_k < 3)
+    lo_k = 3 < normal_k ? 3 : normal_k;
+  if (hi_k > g->k)
+    hi_k = g->k;
+  const size_t scale[3] = {lo_k, normal_k, hi_k};
+  pca_point(cloud, g, normal_k, weight, i, nrm, curv, NULL);
+  for (int s = 0; s < 3; ++s) {
+    if (scale[s] == normal_k)
+      continue;
+    double a[3], c, elong;
+    pca_point(cloud, g, scale[s], weight, i, a, &c, &elong);
+    if (elong >= ADAPTIVE_MIN_SPREAD && c < *curv) {
+      memcpy(nrm, a, sizeof(a));
+      *curv = c;
+    }
+  }
 }
 
 typedef struct normals_job {
@@ -176,6 +222,7 @@ typedef struct normals_job {
   const dacpo_knn_graph* g;
   size_t normal_k;
   double weight;
+  int adaptive;
   double* nrm;
   float* curvature;
 } normals_job;
@@ -191,8 +238,18 @@ normals_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
   size_t end = begin + NORMALS_CHUNK < n ? begin + NORMALS_CHUNK : n;
   for (size_t i = begin; i < end; ++i) {
     double curv;
-    pca_point(
-        job->cloud, job->g, job->normal_k, job->weight, i, job->nrm + 3 * i, &curv);
+    if (job->adaptive)
+      pca_point_adaptive(
+          job->cloud, job->g, job->normal_k, job->weight, i, job->nrm + 3 * i, &curv);
+    else
+      pca_point(job->cloud,
+                job->g,
+                job->normal_k,
+                job->weight,
+                i,
+                job->nrm + 3 * i,
+                &curv,
+                NULL);
     if (job->curvature)
       job->curvature[i] = (float)curv;
   }
@@ -208,8 +265,8 @@ dacpo_normals_pca(const dacpo_cloud* cloud,
                   float* curvature,
                   dacpo_err* err)
 {
-  return dacpo_normals_pca_weighted(
-      cloud, g, normal_k, 0.0, num_threads, nrm_out, curvature, err);
+  return dacpo_normals_pca_scaled(
+      cloud, g, normal_k, 0.0, 0, num_threads, nrm_out, curvature, err);
 }
 
 dacpo_status
@@ -221,6 +278,27 @@ dacpo_normals_pca_weighted(const dacpo_cloud* cloud,
                            double* nrm_out,
                            float* curvature,
                            dacpo_err* err)
+{
+  return dacpo_normals_pca_scaled(
+      cloud, g, normal_k, weight, 0, num_threads, nrm_out, curvature, err);
+}
+
+size_t
+dacpo_normals_width(size_t normal_k, int adaptive)
+{
+  return adaptive ? (3 * normal_k + 1) / 2 : normal_k;
+}
+
+dacpo_status
+dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
+                         const dacpo_knn_graph* g,
+                         size_t normal_k,
+                         double weight,
+                         int adaptive,
+                         unsigned num_threads,
+                         double* nrm_out,
+                         float* curvature,
+                         dacpo_err* err)
 {
   DACPO_CHECK(err,
               cloud != NULL && g != NULL,
@@ -244,7 +322,7 @@ dacpo_normals_pca_weighted(const dacpo_cloud* cloud,
               nrm_out != NULL && cloud->xyz != NULL && (g->k == 0 || g->idx != NULL),
               DACPO_ERR_INVALID_ARGUMENT,
               "normals: NULL array");
-  normals_job job = {cloud, g, normal_k, weight, nrm_out, curvature};
+  normals_job job = {cloud, g, normal_k, weight, adaptive != 0, nrm_out, curvature};
   size_t tasks = (cloud->n + NORMALS_CHUNK - 1) / NORMALS_CHUNK;
   return dacpo_parallel_for(
       tasks, num_threads, normals_task, &job, NULL, DACPO_STAGE_NORMALS, err);

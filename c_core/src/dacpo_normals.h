@@ -32,4 +32,25 @@ dacpo_normals_pca_weighted(const dacpo_cloud* cloud,
                            float* curvature,
                            dacpo_err* err);
 
+/* The same, with adaptive != 0 choosing per point among 3/4, 1 and 3/2 x
+ * normal_k neighbours the scale whose neighbourhood is flattest
+ * (dacpo_params.adaptive_normals); g needs dacpo_normals_width() columns for
+ * the largest scale, fewer clamp it. adaptive 0 is
+ * dacpo_normals_pca_weighted(). */
+dacpo_status
+dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
+                         const dacpo_knn_graph* g,
+                         size_t normal_k,
+                         double weight,
+                         int adaptive,
+                         unsigned num_threads,
+                         double* nrm_out,
+                         float* curvature,
+                         dacpo_err* err);
+
+/* Neighbours per point the normals need: normal_k, or 3/2 x normal_k when
+ * adaptive. */
+size_t
+dacpo_normals_width(size_t normal_k, int adaptive);
+
 #endif

@@ -99,7 +99,9 @@ build_neighbors(run_state* s,
   st->k_clamped = st->k_used != s->p.k;
   size_t kmax = st->k_used;
   if (s->p.estimate_normals) {
-    size_t nk = s->p.normal_k < n - 1 ? s->p.normal_k : n - 1;
+    size_t nk = dacpo_normals_width(s->p.normal_k, s->p.adaptive_normals);
+    if (nk > n - 1)
+      nk = n - 1;
     if (nk > kmax)
       kmax = nk;
   }
@@ -165,14 +167,15 @@ estimate_normals(run_state* s, dacpo_err* err)
   s->curvature = dacpo_malloc_array(n, sizeof(float));
   if (!s->curvature)
     return DACPO_OOM(err);
-  return dacpo_normals_pca_weighted(&s->cloud,
-                                    &s->knn,
-                                    nk,
-                                    s->p.normal_weight,
-                                    s->p.num_threads,
-                                    s->cloud.nrm,
-                                    s->curvature,
-                                    err);
+  return dacpo_normals_pca_scaled(&s->cloud,
+                                  &s->knn,
+                                  nk,
+                                  s->p.normal_weight,
+                                  s->p.adaptive_normals,
+                                  s->p.num_threads,
+                                  s->cloud.nrm,
+                                  s->curvature,
+                                  err);
 }
 
 /* ---- stages 2-3: one block at a time ----------------------------------- */

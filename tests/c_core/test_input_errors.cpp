@@ -588,6 +588,7 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"dipole_c_thin", [](dacpo_params* p) { p->dipole_c_thin = -4.0; }},
       {"normal_weight", [](dacpo_params* p) { p->normal_weight = -1.0; }},
       {"normal_weight", [](dacpo_params* p) { p->normal_weight = INFINITY; }},
+      {"adaptive_normals", [](dacpo_params* p) { p->adaptive_normals = 2; }},
       {"dipole_c_thin", [](dacpo_params* p) { p->dipole_c_thin = NAN; }},
       {"cue_anchor", [](dacpo_params* p) { p->cue_anchor = INFINITY; }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},

@@ -8,6 +8,7 @@ extern "C" {
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -281,6 +282,26 @@ TEST(DacpoNormals, RejectsBadArguments)
   EXPECT_NEAR(std::fabs(nrm[2]), 1.0, 1e-12);
 }
 
+namespace {
+
+// Floor z = 0, x in [0, 0.6), y in [0, 0.6) (the first *floor_points points),
+// and a wall x = 0.6, z in (0, 0.4], sampled at random at about 2 cm spacing.
+std::vector<double>
+floorAndWall(size_t* floor_points)
+{
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> p;
+  for (int i = 0; i < 900; ++i)
+    p.insert(p.end(), {0.6 * u(rng), 0.6 * u(rng), 0.0});
+  *floor_points = p.size() / 3;
+  for (int i = 0; i < 600; ++i)
+    p.insert(p.end(), {0.6, 0.6 * u(rng), 0.001 + 0.399 * u(rng)});
+  return p;
+}
+
+} // namespace
+
 // Near a corner the far half of the 16 nearest lies on the other face: with
 // Gaussian weights (dacpo_params.normal_weight 1.5) the axes of the floor
 // points next to a wall tilt less than with plain PCA (measured: mean |sin| 0.329
@@ -289,16 +310,8 @@ TEST(DacpoNormals, RejectsBadArguments)
 // both give the exact normal.
 TEST(DacpoNormals, WeightsKeepAxesOffTheOtherFaceOfACorner)
 {
-  // floor z = 0, x in [0, 0.6), y in [0, 0.6), and a wall x = 0.6, z in
-  // (0, 0.4], sampled at random at about 2 cm spacing
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> p;
-  for (int i = 0; i < 900; ++i)
-    p.insert(p.end(), {0.6 * u(rng), 0.6 * u(rng), 0.0});
-  const size_t floor_points = p.size() / 3;
-  for (int i = 0; i < 600; ++i)
-    p.insert(p.end(), {0.6, 0.6 * u(rng), 0.001 + 0.399 * u(rng)});
+  size_t floor_points = 0;
+  const std::vector<double> p = floorAndWall(&floor_points);
   DoubleCloud dc(p);
   Graph g;
   dacpo_err err{};
@@ -327,4 +340,162 @@ TEST(DacpoNormals, WeightsKeepAxesOffTheOtherFaceOfACorner)
       ASSERT_LT(axisError(&weighted[3 * i], up), 1e-9) << i;
       ASSERT_LT(axisError(&plain[3 * i], up), 1e-9) << i;
     }
+}
+
+namespace {
+
+// Mean |sin| of the axes of points [begin, end) (those passing keep) against
+// the unit normal want.
+template <typename Keep>
+double
+meanAxisError(const std::vector<double>& axes,
+              size_t begin,
+              size_t end,
+              const double want[3],
+              Keep keep)
+{
+  double sum = 0.0;
+  size_t m = 0;
+  for (size_t i = begin; i < end; ++i)
+    if (keep(i)) {
+      sum += axisError(&axes[3 * i], want);
+      ++m;
+    }
+  return m ? sum / static_cast<double>(m) : -1.0;
+}
+
+struct TwoNormals {
+  std::vector<double> plain, adaptive;
+};
+
+// Plain PCA over 16 neighbours and the adaptive choice among 12 / 16 / 24.
+TwoNormals
+plainAndAdaptive(DoubleCloud& dc, size_t graph_k)
+{
+  Graph g;
+  dacpo_err err{};
+  TwoNormals t;
+  t.plain.resize(dc.xyz.size());
+  t.adaptive.resize(dc.xyz.size());
+  EXPECT_EQ(dacpo_knn_build(&dc.c, graph_k, nullptr, 1, nullptr, &g.g, &err), DACPO_OK);
+  EXPECT_EQ(dacpo_normals_pca(&dc.c, &g.g, 16, 1, t.plain.data(), nullptr, &err),
+            DACPO_OK);
+  EXPECT_EQ(dacpo_normals_pca_scaled(
+                &dc.c, &g.g, 16, 0.0, 1, 2, t.adaptive.data(), nullptr, &err),
+            DACPO_OK)
+      << err.msg;
+  return t;
+}
+
+} // namespace
+
+TEST(DacpoNormals, AdaptiveScaleWidth)
+{
+  EXPECT_EQ(dacpo_normals_width(16, 0), 16u);
+  EXPECT_EQ(dacpo_normals_width(16, 1), 24u);
+  EXPECT_EQ(dacpo_normals_width(3, 1), 5u);
+}
+
+// A sparse corner: the floor points next to a wall see the wall among their
+// 16 nearest; the flatter 12 tilt less (measured: mean |sin| within 2.5
+// spacings of the wall 0.344 plain, 0.303 adaptive). The open floor stays exact.
+TEST(DacpoNormals, AdaptiveScaleKeepsAxesOffTheOtherFaceOfACorner)
+{
+  size_t floor_points = 0;
+  const std::vector<double> p = floorAndWall(&floor_points);
+  DoubleCloud dc(p);
+  const TwoNormals t = plainAndAdaptive(dc, 24);
+  const double up[3] = {0.0, 0.0, 1.0};
+  auto near_wall = [&](size_t i) { return p[3 * i] >= 0.6 - 0.05; };
+  const double plain = meanAxisError(t.plain, 0, floor_points, up, near_wall);
+  const double adaptive = meanAxisError(t.adaptive, 0, floor_points, up, near_wall);
+  std::printf("corner: mean |sin| plain %.4f adaptive %.4f\n", plain, adaptive);
+  EXPECT_LT(adaptive, 0.92 * plain);
+  for (size_t i = 0; i < floor_points; ++i)
+    if (p[3 * i] > 0.1 && p[3 * i] < 0.3 && p[3 * i + 1] > 0.1 && p[3 * i + 1] < 0.5)
+      ASSERT_LT(axisError(&t.adaptive[3 * i], up), 1e-9) << i;
+}
+
+// Noise along the normal (sigma = 0.3 spacing): the larger neighbourhood
+// averages it, so the adaptive axes are better than 16 alone (measured: mean
+// |sin| 0.098 plain, 0.073 adaptive).
+TEST(DacpoNormals, AdaptiveScaleAveragesNoiseOnAPlane)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.006);
+  std::vector<double> p;
+  for (int i = 0; i < 2500; ++i)
+    p.insert(p.end(), {u(rng), u(rng), noise(rng)});
+  DoubleCloud dc(p);
+  const TwoNormals t = plainAndAdaptive(dc, 24);
+  const double up[3] = {0.0, 0.0, 1.0};
+  auto inner = [&](size_t i) {
+    return p[3 * i] > 0.1 && p[3 * i] < 0.9 && p[3 * i + 1] > 0.1 && p[3 * i + 1] < 0.9;
+  };
+  const double plain = meanAxisError(t.plain, 0, p.size() / 3, up, inner);
+  const double adaptive = meanAxisError(t.adaptive, 0, p.size() / 3, up, inner);
+  std::printf("noisy plane: mean |sin| plain %.4f adaptive %.4f\n", plain, adaptive);
+  EXPECT_LT(adaptive, 0.95 * plain);
+}
+
+// A single depth frame's slanted wall (slope 1/2, 1 cm grid): depth quantised
+// into terraces. 12 neighbours on one terrace are flat with the wrong axis;
+// the strip guard (l1 / l2 >= 0.3) keeps them out where a terrace is about one
+// point wide (step 6 mm: mean |sin| 0.078 plain, 0.058 adaptive, the 24
+// averaging the steps), but not where it is 2.4 points wide (step 12 mm: 0.106
+// -> 0.154, 12 neighbours of one terrace pass as a patch). That is the cost the
+// depth frames pay (their worst seed, README). A guard of 0.4 passes both here
+// but took the 15 frames from 2.03 to 2.27 % and the 18 rooms from 5.20 to 5.29
+// % (seeds 1-5, median), so the bound below records today's behaviour.
+static double
+terraceErrors(double step, double* plain, double* adaptive)
+{
+  std::vector<double> p;
+  for (int ix = 0; ix < 60; ++ix)
+    for (int iy = 0; iy < 60; ++iy) {
+      const double x = 0.01 * ix, y = 0.01 * iy;
+      p.insert(p.end(), {x, y, step * std::round(0.5 * x / step)});
+    }
+  DoubleCloud dc(p);
+  const TwoNormals t = plainAndAdaptive(dc, 24);
+  double wall[3] = {-0.5, 0.0, 1.0};
+  const double l = norm3(wall);
+  for (double& w : wall)
+    w /= l;
+  auto inner = [&](size_t i) {
+    return p[3 * i] > 0.05 && p[3 * i] < 0.55 && p[3 * i + 1] > 0.05 &&
+           p[3 * i + 1] < 0.55;
+  };
+  *plain = meanAxisError(t.plain, 0, p.size() / 3, wall, inner);
+  *adaptive = meanAxisError(t.adaptive, 0, p.size() / 3, wall, inner);
+  std::printf("terraces %.3f: mean |sin| plain %.4f adaptive %.4f\n", step, *plain,
+              *adaptive);
+  return *adaptive / *plain;
+}
+
+TEST(DacpoNormals, AdaptiveScaleOnDepthTerraces)
+{
+  double plain, adaptive;
+  EXPECT_LT(terraceErrors(0.006, &plain, &adaptive), 0.85);
+  const double wide = terraceErrors(0.012, &plain, &adaptive);
+  EXPECT_GT(wide, 1.2); // the known cost: 12 neighbours of one terrace
+  EXPECT_LT(wide, 1.6);
+}
+
+// A graph narrower than 3/2 x normal_k clamps the larger scale: still unit
+// axes, and on an exact plane still exact.
+TEST(DacpoNormals, AdaptiveScaleWithANarrowGraph)
+{
+  std::vector<double> p;
+  for (int ix = 0; ix < 20; ++ix)
+    for (int iy = 0; iy < 20; ++iy)
+      p.insert(p.end(), {0.01 * ix, 0.01 * iy + 0.003 * ix, 0.0});
+  DoubleCloud dc(p);
+  const TwoNormals t = plainAndAdaptive(dc, 16);
+  const double up[3] = {0.0, 0.0, 1.0};
+  for (size_t i = 0; i < p.size() / 3; ++i) {
+    ASSERT_NEAR(norm3(&t.adaptive[3 * i]), 1.0, 1e-12);
+    ASSERT_LT(axisError(&t.adaptive[3 * i], up), 1e-9);
+  }
 }

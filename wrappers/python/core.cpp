@@ -54,6 +54,7 @@ defaultParams()
   d["cue_anchor"] = p.cue_anchor;
   d["dipole_c_thin"] = p.dipole_c_thin;
   d["normal_weight"] = p.normal_weight;
+  d["adaptive_normals"] = p.adaptive_normals != 0;
   d["vcr_image_size"] = p.vcr_image_size;
   d["vcr_views"] = p.vcr_views;
   d["vcr_perspective"] = p.vcr_perspective != 0;
@@ -102,6 +103,8 @@ toParams(const py::dict& d)
   p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
   p.dipole_c_thin = get<double>(d, "dipole_c_thin", p.dipole_c_thin);
   p.normal_weight = get<double>(d, "normal_weight", p.normal_weight);
+  p.adaptive_normals =
+      get<bool>(d, "adaptive_normals", p.adaptive_normals != 0) ? 1 : 0;
   p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
   p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
   p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;

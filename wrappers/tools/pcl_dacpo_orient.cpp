@@ -163,6 +163,12 @@ const OptionSpec kOptions[] = {
      "helps rooms with thin furniture)",
      showNumber<double, &dacpo_params::normal_weight>,
      setDouble<&dacpo_params::normal_weight>},
+    {"-adaptive_normals",
+     "X",
+     "estimated normals: 1 = per point the flattest of 3/4, 1 and 3/2 x\n"
+     "normal_k neighbours (sparse rooms, thin parts); 0 = normal_k alone",
+     showNumber<int, &dacpo_params::adaptive_normals>,
+     setUnsigned<int, &dacpo_params::adaptive_normals>},
     {"-estimate",
      nullptr,
      "estimate PCA normals even if the input has normal_x/y/z\n"

@@ -489,8 +489,10 @@ static size_t
 table_width(const dacpo_params* p, size_t n)
 {
   size_t k = p->k;
-  if (p->estimate_normals && p->normal_k > k)
-    k = p->normal_k;
+  /* the core's widest PCA neighbourhood (3/2 x normal_k when adaptive) */
+  const size_t nk = p->adaptive_normals ? (3 * p->normal_k + 1) / 2 : p->normal_k;
+  if (p->estimate_normals && nk > k)
+    k = nk;
   return k + 5 < n ? k + 5 : n;
 }
 

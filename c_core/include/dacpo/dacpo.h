@@ -257,9 +257,21 @@ typedef struct dacpo_params {
                                       the distance of the middle one of the
                                       normal_k; 0 = unweighted (0). Seeds 1-5,
                                       15 frames / 18 rooms, % wrong (worst
-                                      seed): 0 2.20 (2.42) / 5.82 (6.27); 1.5
-                                      2.02 (2.54) / 5.58 (6.07), largest seed
-                                      spread 2.86 -> 3.12 / 1.66 -> 3.64 */
+                                      seed; with adaptive_normals 0): 0 2.20
+                                      (2.42) / 5.82 (6.27); 1.5 2.02 (2.54) /
+                                      5.58 (6.07), largest seed spread 2.86
+                                      -> 3.12 / 1.66 -> 3.64 */
+  int adaptive_normals;          /**< estimated normals: 1 = per point the
+                                      neighbourhood among 3/4, 1 and 3/2 x
+                                      normal_k that is flattest (lowest
+                                      surface variation; another scale than
+                                      normal_k only where its neighbours do
+                                      not form a strip); the k-NN graph then
+                                      keeps 3/2 x normal_k neighbours. 0 =
+                                      normal_k alone. Seeds 1-5, 15 frames /
+                                      18 rooms, % wrong (worst seed): 0 2.20
+                                      (2.42) / 5.82 (6.27); 1 2.03 (2.54) /
+                                      5.20 (5.63) (1) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

@@ -219,6 +219,21 @@ public:
     return params_.normal_weight;
   }
 
+  /** \brief Estimated normals: per point the flattest of 3/4, 1 and 3/2 x
+   *  normal_k neighbours (lowest surface variation, no strips); see
+   *  dacpo_params.adaptive_normals. */
+  void
+  setAdaptiveNormals(bool on)
+  {
+    params_.adaptive_normals = on ? 1 : 0;
+  }
+  /** \brief See setAdaptiveNormals(). */
+  bool
+  getAdaptiveNormals() const
+  {
+    return params_.adaptive_normals != 0;
+  }
+
   /** \brief Target number of blocks; 0 = automatic, n/1250 in [1, 200] (default 0). */
   void
   setNumberOfBlocks(std::size_t num_blocks)

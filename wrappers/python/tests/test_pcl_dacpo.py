@@ -82,6 +82,10 @@ def test_unknown_parameter_names_the_nearest():
     assert pcl_dacpo.default_params()["cue_anchor"] == 1.0
     with pytest.raises(ValueError, match="cue_anchor"):
         pcl_dacpo.orient(pts, cue_anchor=-1.0)
+    assert pcl_dacpo.default_params()["adaptive_normals"] in (False, True)
+    plane, gt = pcl_dacpo.make_scene("plane", 500)
+    normals, _ = pcl_dacpo.orient(plane, adaptive_normals=True)
+    assert wrong_up_to_flip(normals, gt) < 1.0
 
 
 def test_bad_inputs_raise_clear_errors():
