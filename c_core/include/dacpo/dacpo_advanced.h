@@ -186,6 +186,97 @@ dacpo_region_knn(const float* xyz,
                  size_t msg_size);
 
 /** \brief Frees bytes a task or result call returned. NULL-safe. */
+/**
+ * \name Tiles: clouds larger than one process holds
+ *
+ * A cloud too large for one dacpo_orient() (out-of-core on one machine, or
+ * spread over cluster ranks) is cut into spatial tiles; each tile's own points
+ * and a halo around them are oriented by dacpo_orient() on their own, and the
+ * tiles' relative signs are then joined from the halo points, which two tiles
+ * orient:
+ *
+ *   dacpo_tile_plan_create   from a sample (e.g. every s-th point of the file)
+ *   dacpo_tile_locate        per point: its own tile and the tiles whose halo
+ *                            holds it (so a streaming pass can route it)
+ *   dacpo_orient             per tile, its own + halo points in input order
+ *   dacpo_tile_join          overlap evidence -> which tiles to flip
+ *
+ * The plan depends only on the sample, total, max_points and halo: processes
+ * that read the same sample agree on it without talking, and a tile's answer
+ * does not depend on which process runs it. With one tile the result is
+ * dacpo_orient()'s on the whole cloud.
+ * @{
+ */
+typedef struct dacpo_tile_plan dacpo_tile_plan;
+
+/** \brief A kd-split of the sample (m points, 3m floats, finite): cells cut
+ *  at the sample's median along their longest side until each holds at most
+ *  about 0.8 x max_points of the total points (the rest is room for its halo).
+ *  halo: how far (per axis, in coordinate units) a tile reads beyond its cell;
+ *  0 = automatic, 16 spacings of the whole cloud (spacing estimated from the
+ *  sample). Errors: EMPTY_INPUT (m == 0 or m > total), INVALID_ARGUMENT
+ *  (max_points < 16, halo < 0, more than 65,536 tiles), NONFINITE_INPUT,
+ *  OUT_OF_MEMORY. */
+DACPO_API dacpo_status
+dacpo_tile_plan_create(const float* sample,
+                       size_t m,
+                       uint64_t total,
+                       uint64_t max_points,
+                       double halo,
+                       dacpo_tile_plan** out,
+                       char* msg,
+                       size_t msg_size);
+
+/** \brief Number of tiles (ids 0 .. count-1); 0 for NULL. */
+DACPO_API size_t
+dacpo_tile_plan_count(const dacpo_tile_plan* plan);
+
+/** \brief The halo width in use (the automatic one when 0 was asked). */
+DACPO_API double
+dacpo_tile_plan_halo(const dacpo_tile_plan* plan);
+
+/** \brief Estimated own + halo points of a tile (from the sample), for
+ *  dealing tiles to processes by cost. */
+DACPO_API uint64_t
+dacpo_tile_plan_estimate(const dacpo_tile_plan* plan, size_t tile);
+
+/** \brief The tile that owns p (-1 for NULL or a non-finite p). When num_halo
+ *  is not NULL, *num_halo is the number of other tiles whose halo holds p; the
+ *  first max_halo of them are written to halo_tiles (ascending cell order). */
+DACPO_API int32_t
+dacpo_tile_locate(const dacpo_tile_plan* plan,
+                  const float p[3],
+                  int32_t* halo_tiles,
+                  size_t max_halo,
+                  size_t* num_halo);
+
+/** \brief NULL-safe. */
+DACPO_API void
+dacpo_tile_plan_free(dacpo_tile_plan* plan);
+
+/** \brief Evidence between tiles a and b: over points one of them owns and the
+ *  other holds in its halo, the sum of |n_a . n_b| where the two normals agree
+ *  (same) and where they disagree (opposite). */
+typedef struct dacpo_tile_overlap {
+  uint32_t a, b;
+  double same, opposite;
+} dacpo_tile_overlap;
+
+/** \brief Which tiles to flip (flip[t] = 1: negate the normals tile t gave its
+ *  own points). Entries for the same pair (either order) are summed; the
+ *  relative signs follow the maximum spanning forest of |same - opposite|, and
+ *  each connected group keeps the sign that most of its points (tile_points,
+ *  NULL: one per tile) got from their own tile. Errors: INVALID_ARGUMENT. */
+DACPO_API dacpo_status
+dacpo_tile_join(size_t num_tiles,
+                const dacpo_tile_overlap* overlaps,
+                size_t num_overlaps,
+                const uint64_t* tile_points,
+                uint8_t* flip,
+                char* msg,
+                size_t msg_size);
+/** @} */
+
 DACPO_API void
 dacpo_unit_bytes_free(void* bytes);
 
