@@ -13,6 +13,8 @@
  * Cost: O(file size) time, 12 or 24 bytes per point of memory.
  * Failure modes: see the DACPO_PLY_ERR_* codes; never crashes.
  */
+#define _FILE_OFFSET_BITS 64
+#define _POSIX_C_SOURCE 200809L
 #include "dacpo_ply.h"
 
 #include "dacpo_support_err.h"
@@ -816,6 +818,53 @@ open_sized(const char* path, ply_in* in, long* fsize, char* err, size_t errlen)
   return DACPO_PLY_OK;
 }
 
+/* Opens path and reads up to its first vertex row: the header, the vertex
+ * element (*vert, *has_normals), the elements before it, the count check. On
+ * success in->f is open at vertex 0 and in->buf, h->el are allocated; on failure
+ * as much as was opened, which ply_close() releases either way. */
+static int
+open_vertices(const char* path,
+              ply_in* in,
+              ply_header* h,
+              ply_element** vert,
+              int* has_normals,
+              char* err,
+              size_t errlen)
+{
+  long fsize = 0;
+  memset(in, 0, sizeof(*in));
+  memset(h, 0, sizeof(*h));
+  int status = open_sized(path, in, &fsize, err, errlen);
+  if (status != DACPO_PLY_OK) {
+    in->f = NULL;
+    return status;
+  }
+  in->buf = (unsigned char*)malloc(PLY_BUF_SIZE);
+  h->el = (ply_element*)malloc(PLY_MAX_ELEMENTS * sizeof(ply_element));
+  if (!in->buf || !h->el) {
+    dacpo_support_err(err, errlen, "out of memory");
+    return DACPO_PLY_ERR_MEMORY;
+  }
+  /* each step runs only if the ones before succeeded */
+  status = read_header(in, h, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = find_vertex(h, path, vert, has_normals, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = skip_elements_before(in, h, *vert, fsize, path, err, errlen);
+  if (status == DACPO_PLY_OK)
+    status = check_vertex_count(in, h->format, *vert, fsize, path, err, errlen);
+  return status;
+}
+
+static void
+ply_close(ply_in* in, ply_header* h)
+{
+  free(h->el);
+  free(in->buf);
+  if (in->f)
+    fclose(in->f);
+}
+
 int
 dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
 {
@@ -823,8 +872,6 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   ply_header h;
   ply_element* vert = NULL;
   int has_normals = 0;
-  long fsize = 0;
-  int status = DACPO_PLY_OK;
   dacpo_ply_cloud c;
 
   if (err && errlen > 0)
@@ -836,46 +883,103 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
         err, errlen, "dacpo_ply_read: %s is NULL", !path ? "path" : "out");
     return DACPO_PLY_ERR_ARGUMENT;
   }
-  memset(&in, 0, sizeof(in));
-  memset(&h, 0, sizeof(h));
   memset(&c, 0, sizeof(c));
-  status = open_sized(path, &in, &fsize, err, errlen);
-  if (status != DACPO_PLY_OK)
-    return status;
-  in.buf = (unsigned char*)malloc(PLY_BUF_SIZE);
-  h.el = (ply_element*)malloc(PLY_MAX_ELEMENTS * sizeof(ply_element));
-  if (!in.buf || !h.el) {
-    dacpo_support_err(err, errlen, "out of memory");
-    status = DACPO_PLY_ERR_MEMORY;
-    goto done;
-  }
-
-  /* each step runs only if the ones before succeeded */
-  status = read_header(&in, &h, err, errlen);
-  if (status == DACPO_PLY_OK)
-    status = find_vertex(&h, path, &vert, &has_normals, err, errlen);
-  if (status == DACPO_PLY_OK)
-    status = skip_elements_before(&in, &h, vert, fsize, path, err, errlen);
-  if (status == DACPO_PLY_OK)
-    status = check_vertex_count(&in, h.format, vert, fsize, path, err, errlen);
+  int status = open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
   if (status == DACPO_PLY_OK)
     status = read_vertices(&in, h.format, vert, has_normals, &c, path, err, errlen);
-  if (status != DACPO_PLY_OK)
-    goto done;
-  if (ferror(in.f)) {
+  if (status == DACPO_PLY_OK && ferror(in.f)) {
     dacpo_support_err(err, errlen, "read error on '%s'", path);
     status = DACPO_PLY_ERR_IO;
-    goto done;
   }
-  *out = c;
-  memset(&c, 0, sizeof(c));
-
-done:
+  if (status == DACPO_PLY_OK) {
+    *out = c;
+    memset(&c, 0, sizeof(c));
+  }
   dacpo_ply_cloud_free(&c);
-  free(h.el);
-  free(in.buf);
-  fclose(in.f);
+  ply_close(&in, &h);
   return status;
+}
+
+int
+dacpo_ply_rows_open(const char* path, dacpo_ply_rows* out, char* err, size_t errlen)
+{
+  ply_in in;
+  ply_header h;
+  ply_element* vert = NULL;
+  int has_normals = 0;
+  if (err && errlen > 0)
+    err[0] = '\0';
+  if (!path || !out) {
+    dacpo_support_err(err, errlen, "dacpo_ply_rows_open: NULL argument");
+    return DACPO_PLY_ERR_ARGUMENT;
+  }
+  memset(out, 0, sizeof(*out));
+  int status = open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
+  if (status == DACPO_PLY_OK && h.format == FMT_ASCII) {
+    dacpo_support_err(err,
+                      errlen,
+                      "'%s' is ASCII PLY: reading it in parts needs binary PLY "
+                      "(convert it first, e.g. pcl_dacpo_orient writes binary PLY)",
+                      path);
+    status = DACPO_PLY_ERR_FORMAT;
+  }
+  for (int j = 0; status == DACPO_PLY_OK && j < vert->nprops; ++j)
+    if (vert->props[j].count_type != T_NONE) {
+      dacpo_support_err(
+          err, errlen, "'%s': the vertex element has a list property: rows differ in size", path);
+      status = DACPO_PLY_ERR_FORMAT;
+    }
+  if (status == DACPO_PLY_OK) {
+    out->n = vert->count;
+    out->data_offset = in.consumed;
+    out->swap = h.format == FMT_BBE;
+    size_t off = 0;
+    for (int j = 0; j < vert->nprops; ++j) {
+      const ply_prop* pr = &vert->props[j];
+      if (pr->role >= 0 && pr->role < 3) {
+        out->offset[pr->role] = off;
+        out->type[pr->role] = (int)pr->type;
+      }
+      off += type_size(pr->type);
+    }
+    out->stride = off;
+  }
+  ply_close(&in, &h);
+  return status;
+}
+
+int
+dacpo_ply_rows_read(FILE* f,
+                    const dacpo_ply_rows* rows,
+                    unsigned long long first,
+                    size_t count,
+                    float* xyz,
+                    char* err,
+                    size_t errlen)
+{
+  if (!f || !rows || (!xyz && count > 0) || first > rows->n || count > rows->n - first) {
+    dacpo_support_err(err, errlen, "dacpo_ply_rows_read: bad argument or range");
+    return DACPO_PLY_ERR_ARGUMENT;
+  }
+  unsigned char buf[PLY_BUF_SIZE];
+  const size_t per = PLY_BUF_SIZE / rows->stride;
+  if (per == 0 || fseeko(f, (off_t)(rows->data_offset + first * rows->stride), SEEK_SET) != 0) {
+    dacpo_support_err(err, errlen, "cannot seek to vertex %llu", first);
+    return DACPO_PLY_ERR_IO;
+  }
+  for (size_t done = 0; done < count;) {
+    const size_t take = count - done < per ? count - done : per;
+    if (fread(buf, rows->stride, take, f) != take) {
+      dacpo_support_err(err, errlen, "short read at vertex %llu", first + done);
+      return DACPO_PLY_ERR_IO;
+    }
+    for (size_t i = 0; i < take; ++i)
+      for (int k = 0; k < 3; ++k)
+        xyz[3 * (done + i) + (size_t)k] = (float)decode(
+            buf + i * rows->stride + rows->offset[k], (ply_type)rows->type[k], rows->swap);
+    done += take;
+  }
+  return DACPO_PLY_OK;
 }
 
 void

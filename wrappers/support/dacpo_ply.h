@@ -18,6 +18,7 @@
 #define DACPO_PLY_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -64,6 +65,42 @@ dacpo_ply_write(const char* path,
  */
 int
 dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen);
+
+/** \brief Where the vertex rows of a binary PLY lie, for reading any range of
+ *  them without the rest (out-of-core and per-rank reading). Needs
+ *  binary_little_endian or binary_big_endian and vertex rows of scalar
+ *  properties only (no lists), so that every row has the same size. */
+typedef struct dacpo_ply_rows {
+  unsigned long long n;           /**< number of vertices */
+  unsigned long long data_offset; /**< file offset of vertex 0 */
+  size_t stride;                  /**< bytes per vertex row */
+  size_t offset[3];               /**< x, y, z within a row */
+  int type[3];                    /**< their scalar types (internal codes) */
+  int swap;                       /**< 1: big-endian values */
+} dacpo_ply_rows;
+
+/**
+ * \brief Parse the header of path and locate its vertex rows.
+ * \return DACPO_PLY_OK; DACPO_PLY_ERR_FORMAT with a message for ASCII files,
+ *  list properties in the vertex element or truncated files; DACPO_PLY_ERR_IO.
+ */
+int
+dacpo_ply_rows_open(const char* path, dacpo_ply_rows* out, char* err, size_t errlen);
+
+/**
+ * \brief Positions of vertices [first, first + count) into xyz (3 count floats),
+ *  read from f (opened "rb" on the same file) at their offsets.
+ * \return DACPO_PLY_OK, DACPO_PLY_ERR_ARGUMENT (range beyond n), or
+ *  DACPO_PLY_ERR_IO (short read).
+ */
+int
+dacpo_ply_rows_read(FILE* f,
+                    const dacpo_ply_rows* rows,
+                    unsigned long long first,
+                    size_t count,
+                    float* xyz,
+                    char* err,
+                    size_t errlen);
 
 /** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
 void

@@ -86,3 +86,42 @@ dacpo_mpi_all_ok(int ok)
   dacpo_mpi_wait(&req);
   return all;
 }
+
+/* owner[u] for `count` units of cost[u]: costliest first (ties by id) to the
+ * least loaded rank (ties: the lowest rank). The same on every rank. */
+int*
+dacpo_mpi_deal(const double* cost, size_t count, int ranks)
+{
+  int* owner = malloc((count + 1) * sizeof(int));
+  size_t* order = malloc((count + 1) * sizeof(size_t));
+  double* load = calloc((size_t)ranks, sizeof(double));
+  if (!owner || !order || !load) {
+    free(owner);
+    owner = NULL;
+    goto done;
+  }
+  for (size_t u = 0; u < count; ++u)
+    order[u] = u;
+  for (size_t i = 1; i < count; ++i) { /* insertion sort: a few thousand units */
+    const size_t u = order[i];
+    size_t j = i;
+    while (j > 0 && (cost[order[j - 1]] < cost[u] ||
+                     (cost[order[j - 1]] == cost[u] && order[j - 1] > u))) {
+      order[j] = order[j - 1];
+      --j;
+    }
+    order[j] = u;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    int best = 0;
+    for (int r = 1; r < ranks; ++r)
+      if (load[r] < load[best])
+        best = r;
+    owner[order[i]] = best;
+    load[best] += cost[order[i]];
+  }
+done:
+  free(order);
+  free(load);
+  return owner;
+}

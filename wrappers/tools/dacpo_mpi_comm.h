@@ -32,4 +32,10 @@ dacpo_mpi_send(
 int
 dacpo_mpi_all_ok(int ok);
 
+/* owner[u] of `count` units of cost[u]: costliest first (ties by id) to the
+ * least loaded rank (ties: the lowest rank); the same on every rank. malloc'ed
+ * (NULL when memory ran out). */
+int*
+dacpo_mpi_deal(const double* cost, size_t count, int ranks);
+
 #endif

@@ -18,10 +18,13 @@
 #include <pcl/point_types.h>
 #include <pcl/PolygonMesh.h>
 
+#include "dacpo_ply.h"
+#include "dacpo_tiled.h"
 #include "dacpo_tool_io.h"
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -80,6 +83,9 @@ struct Options {
   std::string mesh;                  /* -mesh file.ply */
   std::string sign;                  /* -sign free|keep */
   std::string viewpoint;             /* -vp x,y,z */
+  double memory = 0.0;               /* -memory: bytes, 0 = in core */
+  double tile_halo = 0.0;            /* -tile_halo: metres, 0 = automatic */
+  std::uint64_t tile_points = 0;     /* -tiles: points per tile, 0 = from -memory */
   bool separate = false, bridge = false;
 };
 
@@ -217,6 +223,60 @@ const OptionSpec kOptions[] = {
      "all blocks from the final normals, wound like them)",
      nullptr,
      setText<&Options::mesh>},
+    {"-memory",
+     "X[K|M|G]",
+     "out of core: hold at most about X bytes (binary PLY in\n"
+     "and .ply out); a larger cloud is oriented in spatial\n"
+     "tiles read from disk one at a time, their signs joined\n"
+     "where their halos overlap (normals always estimated)",
+     nullptr,
+     [](Options& o, const std::string& s, std::string& error) {
+       double v = 0.0, unit = 1.0;
+       std::string num = s;
+       if (!num.empty()) {
+         const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(num.back())));
+         if (c == 'K' || c == 'M' || c == 'G') {
+           unit = c == 'K' ? 1024.0 : c == 'M' ? 1048576.0 : 1073741824.0;
+           num.pop_back();
+         }
+       }
+       if (!toDouble(num, v) || !(v > 0.0) || !std::isfinite(v * unit)) {
+         error = "expects a size such as 4G or 512M, got '" + s + "'";
+         return false;
+       }
+       o.memory = v * unit;
+       if (o.memory < 2.0 * DACPO_TILED_BASE_BYTES) {
+         error = "needs at least " +
+                 std::to_string(static_cast<int>(2.0 * DACPO_TILED_BASE_BYTES / 1048576.0)) +
+                 "M, got '" + s + "'";
+         return false;
+       }
+       return true;
+     }},
+    {"-tiles",
+     "P",
+     "out of core with tiles of at most P points (own +\n"
+     "halo) instead of a -memory budget",
+     nullptr,
+     [](Options& o, const std::string& s, std::string& error) {
+       if (!toUnsigned(s, o.tile_points) || o.tile_points < 16) {
+         error = "expects a number of points >= 16, got '" + s + "'";
+         return false;
+       }
+       return true;
+     }},
+    {"-tile_halo",
+     "X",
+     "with -memory: how far a tile reads beyond its cell\n"
+     "(coordinate units; default: 16 spacings of the cloud)",
+     nullptr,
+     [](Options& o, const std::string& s, std::string& error) {
+       if (!toDouble(s, o.tile_halo) || !(o.tile_halo > 0.0) || !std::isfinite(o.tile_halo)) {
+         error = "expects a positive number, got '" + s + "'";
+         return false;
+       }
+       return true;
+     }},
     {"-sign",
      "free|keep",
      "global sign: normals face the free space the scan\n"
@@ -1021,11 +1081,78 @@ parseOptions(int argc, char** argv, Options& o)
 
 } // namespace
 
+constexpr int kFitsInCore = -1;
+
+/* -memory / -tiles: a cloud larger than the budget allows is oriented tile by tile
+ * from disk (dacpo_tiled.c); kFitsInCore when it fits (the in-core path runs,
+ * the answer is the same as without -memory), else 0 / 1. */
+int
+orientTiled(const std::string& in, const std::string& out, const Options& options)
+{
+  dacpo_tiled_options t{};
+  t.input = in.c_str();
+  t.output = out.c_str();
+  t.max_points = options.tile_points ? options.tile_points
+                                     : dacpo_tiled_points_for_memory(options.memory);
+  t.halo = options.tile_halo;
+  t.params = options.params;
+  t.params.estimate_normals = 1;
+  char err[512] = "";
+  dacpo_ply_rows rows;
+  if (dacpo_tool::extension(in) != ".ply" ||
+      dacpo_ply_rows_open(in.c_str(), &rows, err, sizeof(err)) != 0) {
+    print_error("Error: -memory reads binary PLY: %s\n",
+                err[0] ? err : ("'" + in + "' is not a .ply file").c_str());
+    return 1;
+  }
+  if (rows.n <= t.max_points)
+    return kFitsInCore;
+  if (dacpo_tool::extension(out) != ".ply" || options.labels || !options.edges.empty() ||
+      !options.blocks_colored.empty() || !options.mesh.empty() ||
+      !options.normals_colored.empty()) {
+    print_error("Error: '%s' (%llu points) needs tiles under -memory (at most %llu points "
+                "in core): write a .ply, without -labels, -edges, -blocks_colored, -mesh "
+                "or -normals_colored\n",
+                in.c_str(),
+                static_cast<unsigned long long>(rows.n),
+                static_cast<unsigned long long>(t.max_points));
+    return 1;
+  }
+  dacpo_tiled_report rep;
+  if (dacpo_tiled_orient(&t, &rep, err, sizeof(err)) != 0) {
+    print_error("Error: %s\n", err);
+    return 1;
+  }
+  std::fprintf(stderr,
+               "tiles: points=%llu tiles=%zu halo=%.4g halo_points=%llu largest_tile=%llu "
+               "flipped_tiles=%zu blocks=%zu seconds_sample=%.2f seconds_route=%.2f "
+               "seconds_tiles=%.2f seconds_join=%.2f seconds_flip=%.2f peak_rss_mb=%.1f\n",
+               static_cast<unsigned long long>(rep.points),
+               rep.tiles,
+               rep.halo,
+               static_cast<unsigned long long>(rep.halo_points),
+               static_cast<unsigned long long>(rep.largest_tile),
+               rep.flipped_tiles,
+               rep.blocks,
+               rep.seconds[0],
+               rep.seconds[1],
+               rep.seconds[2],
+               rep.seconds[3],
+               rep.seconds[4],
+               peakRssMb());
+  return 0;
+}
+
 /* One input to one output (and the side outputs), then the stats line;
  * 0 on success, 1 on failure (the message is printed). */
 int
 orientFile(const std::string& in, const std::string& out, const Options& options)
 {
+  if (options.memory > 0.0 || options.tile_points > 0) {
+    const int tiled = orientTiled(in, out, options);
+    if (tiled != kFitsInCore)
+      return tiled;
+  }
   pcl::PCLPointCloud2 cloud;
   if (!loadCloud(in, cloud))
     return 1;

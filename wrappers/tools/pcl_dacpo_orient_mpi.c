@@ -42,6 +42,8 @@
 
 #include "dacpo_mpi_comm.h"
 #include "dacpo_mpi_knn.h"
+#include "dacpo_mpi_tiles.h"
+#include "dacpo_tiled.h"
 #include "dacpo_pcd.h"
 #include <sys/resource.h>
 
@@ -63,6 +65,8 @@ typedef struct options {
   const char* report;
   int estimate, whole, quiet, spread_knn;
   double knn_halo;
+  uint64_t tile_points; /* -tiles P / -memory X: tiled mode, 0 = off */
+  double tile_halo;
   dacpo_params p;
 } options;
 
@@ -131,6 +135,24 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         return 0;
       }
     }
+    else if ((!strcmp(a, "-memory") || !strcmp(a, "-tile_halo")) && has_value) {
+      char* end = NULL;
+      double x = strtod(argv[++i], &end);
+      const char u = *end;
+      if (a[1] == 'm' && (u == 'K' || u == 'M' || u == 'G' || u == 'k' || u == 'm' || u == 'g')) {
+        x *= u == 'K' || u == 'k' ? 1024.0 : u == 'M' || u == 'm' ? 1048576.0 : 1073741824.0;
+        ++end;
+      }
+      if (*end != '\0' || !(x > 0.0) || !isfinite(x)) {
+        snprintf(msg, msg_size, "%s needs a positive %s, got %s", a,
+                 a[1] == 'm' ? "size (e.g. 4G)" : "number", argv[i]);
+        return 0;
+      }
+      if (a[1] == 'm')
+        o->tile_points = dacpo_tiled_points_for_memory(x);
+      else
+        o->tile_halo = x;
+    }
     else if (!strcmp(a, "-report") && has_value)
       o->report = argv[++i];
     else if (a[0] == '-' && has_value && parse_size(argv[i + 1], &v)) {
@@ -145,6 +167,8 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         o->p.normal_k = v;
       else if (!strcmp(a, "-threads"))
         o->p.num_threads = (unsigned)v;
+      else if (!strcmp(a, "-tiles") && v >= 16)
+        o->tile_points = v;
       else {
         snprintf(msg, msg_size, "unknown option %s", a);
         return 0;
@@ -178,45 +202,6 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
 }
 
 /* ---- dealing out units ------------------------------------------------- */
-
-/* owner[u] for `count` units of cost[u]: costliest first (ties by id) to the
- * least loaded rank (ties: the lowest rank). The same on every rank. */
-static int*
-deal(const double* cost, size_t count, int ranks)
-{
-  int* owner = malloc((count + 1) * sizeof(int));
-  size_t* order = malloc((count + 1) * sizeof(size_t));
-  double* load = calloc((size_t)ranks, sizeof(double));
-  if (!owner || !order || !load) {
-    free(owner);
-    owner = NULL;
-    goto done;
-  }
-  for (size_t u = 0; u < count; ++u)
-    order[u] = u;
-  for (size_t i = 1; i < count; ++i) { /* insertion sort: a few thousand units */
-    const size_t u = order[i];
-    size_t j = i;
-    while (j > 0 && (cost[order[j - 1]] < cost[u] ||
-                     (cost[order[j - 1]] == cost[u] && order[j - 1] > u))) {
-      order[j] = order[j - 1];
-      --j;
-    }
-    order[j] = u;
-  }
-  for (size_t i = 0; i < count; ++i) {
-    int best = 0;
-    for (int r = 1; r < ranks; ++r)
-      if (load[r] < load[best])
-        best = r;
-    owner[order[i]] = best;
-    load[best] += cost[order[i]];
-  }
-done:
-  free(order);
-  free(load);
-  return owner;
-}
 
 /* A unit's task and result on a rank that is not rank 0. */
 typedef struct unit_msg {
@@ -604,14 +589,14 @@ orient(const options* o,
   }
   size_t nb = 0, ne = 0;
   double* bcost = share_costs(job, rank, 0, &nb);
-  int* bowner = bcost ? deal(bcost, nb, ranks) : NULL;
+  int* bowner = bcost ? dacpo_mpi_deal(bcost, nb, ranks) : NULL;
   int ok = dacpo_mpi_all_ok(bowner != NULL) &&
            dacpo_mpi_all_ok(
                run_units(job, &blocks_kind, nb, bowner, rank, rep, &rep->blocks));
   rep->wall[1] = now() - *t;
   *t = now();
   double* ecost = ok ? share_costs(job, rank, 1, &ne) : NULL;
-  int* eowner = ecost ? deal(ecost, ne, ranks) : NULL;
+  int* eowner = ecost ? dacpo_mpi_deal(ecost, ne, ranks) : NULL;
   ok =
       ok && dacpo_mpi_all_ok(eowner != NULL) &&
       dacpo_mpi_all_ok(run_units(job, &edges_kind, ne, eowner, rank, rep, &rep->edges));
@@ -666,6 +651,57 @@ write_output(const char* path, const dacpo_ply_cloud* cloud)
   return ok;
 }
 
+/* -tiles / -memory: dacpo_mpi_tiles.c, then the rank table. */
+static int
+tiled_main(const options* o, int rank, int ranks)
+{
+  if (strlen(o->out) < 4 || strcmp(o->out + strlen(o->out) - 4, ".ply") != 0) {
+    if (rank == 0)
+      fprintf(stderr, "Error: -tiles / -memory write a .ply, got %s\n", o->out);
+    MPI_Finalize();
+    return 1;
+  }
+  dacpo_mpi_tiles_report rep;
+  const double t0 = now();
+  const int ok =
+      dacpo_mpi_tiles_orient(o->in, o->out, &o->p, o->tile_points, o->tile_halo, rank, ranks, &rep);
+  const double wall = now() - t0;
+  const double rss = peak_rss_mb();
+  double mine[12] = {rep.wall[0], rep.wall[1], rep.wall[2], rep.wall[3], rep.wall[4], rep.busy,
+                     rep.tiles, rep.held_points, rss, rep.traffic.sent_mb,
+                     rep.traffic.received_mb, wall};
+  double* all = rank == 0 ? malloc(12 * (size_t)ranks * sizeof(double)) : NULL;
+  MPI_Gather(mine, 12, MPI_DOUBLE, all, 12, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (rank == 0 && ok && all) {
+    FILE* f = o->report ? fopen(o->report, "w") : NULL;
+    if (!o->quiet)
+      printf("tiles=%.0f halo=%.4g flipped_tiles=%.0f\n"
+             "rank  read+plan  route  tiles   join  write   busy  tiles  held points  "
+             "peak RSS MB  sent MB  recv MB\n",
+             rep.num_tiles, rep.halo, rep.flipped_tiles);
+    for (int r = 0; r < ranks; ++r) {
+      const double* x = all + 12 * r;
+      if (!o->quiet)
+        printf("%4d %10.2f %6.2f %6.2f %6.2f %6.2f %6.2f %6.0f %12.0f %12.1f %8.1f %8.1f\n",
+               r, x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10]);
+      if (f)
+        fprintf(f,
+                "{\"rank\": %d, \"ranks\": %d, \"mode\": \"tiles\", \"num_tiles\": %.0f, "
+                "\"halo\": %.6g, \"read_plan_s\": %.3f, \"route_s\": %.3f, \"tiles_s\": %.3f, "
+                "\"join_s\": %.3f, \"write_s\": %.3f, \"busy_s\": %.3f, \"tiles\": %.0f, "
+                "\"held_points\": %.0f, \"peak_rss_mb\": %.1f, \"sent_mb\": %.3f, "
+                "\"received_mb\": %.3f, \"wall_s\": %.3f}\n",
+                r, ranks, rep.num_tiles, rep.halo, x[0], x[1], x[2], x[3], x[4], x[5], x[6],
+                x[7], x[8], x[9], x[10], x[11]);
+    }
+    if (f)
+      fclose(f);
+  }
+  free(all);
+  MPI_Finalize();
+  return ok ? 0 : 2;
+}
+
 static void
 print_help(void)
 {
@@ -691,6 +727,17 @@ print_help(void)
       "  -knn_halo H   -spread_knn's first halo width, in the cloud's units (default:\n"
       "                from its box and size; rows it does not cover ask again 4x "
       "wider)\n"
+      "  -tiles P      tiled mode: no rank holds the whole cloud; every rank reads its\n"
+      "                own byte range of a binary PLY, points go to spatial tiles of\n"
+      "                at most P points (own + halo) dealt to the ranks by size, each\n"
+      "                tile is oriented by dacpo_orient(), their signs are joined on\n"
+      "                rank 0 from the halos, and every rank writes its range (MPI-IO).\n"
+      "                Same bytes as pcl_dacpo_orient -memory with the same tile size,\n"
+      "                for any number of ranks. Output .ply only.\n"
+      "  -memory X     tiled mode with the tile size of pcl_dacpo_orient -memory X\n"
+      "                (X bytes per rank, e.g. 4G)\n"
+      "  -tile_halo H  tiled mode: how far a tile reads beyond its cell (default: 16\n"
+      "                spacings of the cloud)\n"
       "  -report F     one JSON line per rank: wall time per phase, time in its "
       "units,\n"
       "                peak RSS, MB sent and received\n"
@@ -729,6 +776,8 @@ main(int argc, char** argv)
     MPI_Finalize();
     return 1;
   }
+  if (o.tile_points)
+    return tiled_main(&o, rank, ranks);
   rank_report rep;
   memset(&rep, 0, sizeof(rep));
   double t = now();

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Tiles (pcl_dacpo_orient -tiles / -memory, pcl_dacpo_orient_mpi -tiles): a
+# generated building cut into tiles is oriented out of core to a bounded error;
+# with MPI, 1, 2 and 3 ranks write the same bytes as one process while no rank
+# holds every point; a cloud that fits gives the in-core answer; bad input and
+# bad combinations fail with a message and leave no file.
+#
+#   check_tiles.sh MAKE_SCENE ORIENT EVAL [ORIENT_MPI MPIEXEC] WORKDIR
+set -euo pipefail
+MAKE=$1 ORIENT=$2 EVAL=$3
+if [ $# -ge 6 ]; then MPI_TOOL=$4 MPIEXEC=$5 W=$6; else MPI_TOOL="" MPIEXEC="" W=$4; fi
+mkdir -p "$W"
+fail() { echo "FAIL: $*"; exit 1; }
+wrong() { "$EVAL" "$1" "$2" -json | sed -n 's/.*"wrong_pct": *\([0-9.]*\).*/\1/p'; }
+
+"$MAKE" "$W/b.ply" -scene building -n 40000 -seed 2 > /dev/null
+out=$("$ORIENT" "$W/b.ply" "$W/tiled.ply" -tiles 12000 -seed 1 -threads 2 2>&1)
+tiles=$(sed -n 's/.*tiles: points=40000 tiles=\([0-9]*\).*/\1/p' <<< "$out")
+[ "${tiles:-0}" -ge 3 ] || fail "40K points in tiles of 12,000 made ${tiles:-?} tiles: $out"
+largest=$(sed -n 's/.*largest_tile=\([0-9]*\).*/\1/p' <<< "$out")
+[ "${largest:-99999}" -le 12000 ] || fail "the largest tile holds $largest points (> 12,000)"
+w=$(wrong "$W/b.ply" "$W/tiled.ply")
+echo "building 40K in $tiles tiles (largest $largest points): $w % wrong"
+# measured 2026-12-03: 4.68 % (in one piece: see the closing note)
+awk -v w="$w" 'BEGIN { exit !(w != "" && w <= 8) }' || fail "tiled: $w % wrong (bound 8 %)"
+ls -a "$W" | grep -q '^\.dacpo' && fail "temporary tile files were left behind"
+
+# a cloud within the budget runs in core: the answer of a run without -tiles
+"$ORIENT" "$W/b.ply" "$W/fits.ply" -tiles 100000 -seed 1 -q
+"$ORIENT" "$W/b.ply" "$W/incore.ply" -seed 1 -q
+[ "$(wrong "$W/b.ply" "$W/fits.ply")" = "$(wrong "$W/b.ply" "$W/incore.ply")" ] ||
+  fail "a cloud that fits the budget got another answer than in core"
+
+# bad input and combinations: a message, a non-zero status, no output
+set +e
+hl=$(grep -a -b -m1 "^end_header" "$W/b.ply" | cut -d: -f1); hl=$((hl + 11))
+{ head -c "$hl" "$W/b.ply"; printf '\x00\x00\xc0\x7f'; tail -c +"$((hl + 5))" "$W/b.ply"; } > "$W/nan.ply"
+o=$("$ORIENT" "$W/nan.ply" "$W/x.ply" -tiles 12000 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "point 0 .* not finite" <<< "$o" || fail "NaN point: status $st: $o"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n' > "$W/ascii.ply"
+o=$("$ORIENT" "$W/ascii.ply" "$W/x.ply" -tiles 16 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "binary PLY" <<< "$o" || fail "ASCII PLY: status $st: $o"
+o=$("$ORIENT" "$W/b.ply" "$W/x.pcd" -tiles 12000 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "write a .ply" <<< "$o" || fail ".pcd output with tiles: status $st: $o"
+o=$("$ORIENT" "$W/b.ply" "$W/x.ply" -tiles 12000 -labels 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "without -labels" <<< "$o" || fail "-labels with tiles: status $st: $o"
+o=$("$ORIENT" "$W/b.ply" "$W/x.ply" -memory 10M 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "needs at least" <<< "$o" || fail "-memory 10M: status $st: $o"
+set -e
+[ ! -e "$W/x.ply" ] && [ ! -e "$W/x.pcd" ] || fail "a failed run left an output file"
+echo "tiles: fits-in-core answer, NaN, ASCII, .pcd, -labels and too small a budget checked"
+
+[ -n "$MPI_TOOL" ] || exit 0
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_btl_vader_single_copy_mechanism=none
+run() { local np=$1; shift; timeout 300 "$MPIEXEC" -np "$np" --oversubscribe --bind-to none "$MPI_TOOL" "$@"; }
+for np in 1 2 3; do
+  run "$np" "$W/b.ply" "$W/mpi$np.ply" -tiles 12000 -seed 1 -q -report "$W/mpi$np.json"
+  cmp "$W/tiled.ply" "$W/mpi$np.ply" || fail "$np ranks write other bytes than one process"
+done
+# with 3 ranks no rank holds all 40,000 points; together they hold every one
+held=$(sed -n 's/.*"held_points": \([0-9]*\).*/\1/p' "$W/mpi3.json")
+[ "$(wc -l <<< "$held")" -eq 3 ] || fail "the 3-rank report has not 3 lines"
+for h in $held; do [ "$h" -lt 40000 ] || fail "a rank held $h of 40,000 points"; done
+[ "$(paste -sd+ <<< "$held" | bc)" -ge 40000 ] || fail "the ranks held fewer points than the cloud"
+set +e
+o=$(run 2 "$W/nan.ply" "$W/x.ply" -tiles 12000 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "not finite" <<< "$o" || fail "mpi NaN point: status $st: $o"
+o=$(run 2 "$W/b.ply" "$W/x.pcd" -tiles 12000 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "write a .ply" <<< "$o" || fail "mpi .pcd output: status $st: $o"
+set -e
+[ ! -e "$W/x.ply" ] && [ ! -e "$W/x.pcd" ] || fail "a failed mpi run left an output file"
+echo "tiles: 1, 2 and 3 ranks write the bytes of one process; held points per rank: $(echo $held)"
