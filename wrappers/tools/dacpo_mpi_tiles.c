@@ -371,8 +371,7 @@ orient_and_join(tiles_run* t,
   vec* out = calloc((size_t)t->ranks, sizeof(vec));
   uint64_t* own_count = calloc(t->T, sizeof(uint64_t));
   ok = ok && out && own_count;
-  dacpo_params p = *params;
-  p.estimate_normals = 1;
+  const dacpo_params p = dacpo_tiled_params(params);
   double t0 = now_s();
   for (size_t k = 0; ok && k < t->T; ++k) {
     if (t->tile_rank[k] != t->rank || t->tile[k].size == 0)

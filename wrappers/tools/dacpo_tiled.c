@@ -83,6 +83,17 @@ dacpo_tiled_sample_stride(uint64_t n)
   return n == 0 ? 1 : (n + DACPO_TILED_SAMPLE - 1) / DACPO_TILED_SAMPLE;
 }
 
+dacpo_params
+dacpo_tiled_params(const dacpo_params* user)
+{
+  dacpo_params d, p = *user;
+  dacpo_params_init(&d);
+  p.estimate_normals = 1;
+  if (p.weak_edge_fraction == d.weak_edge_fraction)
+    p.weak_edge_fraction = DACPO_TILED_WEAK_EDGE_FRACTION;
+  return p;
+}
+
 uint64_t
 dacpo_tiled_points_for_memory(double bytes)
 {

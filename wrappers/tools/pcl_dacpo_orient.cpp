@@ -304,7 +304,7 @@ const OptionSpec kOptions[] = {
      "X",
      "block edges with less than X times the typical evidence\n"
      "leave their blocks to the viewpoint vote, 0 = only\n"
-     "disconnected parts",
+     "disconnected parts (with tiles the default is 0)",
      showNumber<double, &dacpo_params::weak_edge_fraction>,
      setDouble<&dacpo_params::weak_edge_fraction>},
     {"-bridge",
@@ -1095,8 +1095,7 @@ orientTiled(const std::string& in, const std::string& out, const Options& option
   t.max_points = options.tile_points ? options.tile_points
                                      : dacpo_tiled_points_for_memory(options.memory);
   t.halo = options.tile_halo;
-  t.params = options.params;
-  t.params.estimate_normals = 1;
+  t.params = dacpo_tiled_params(&options.params);
   char err[512] = "";
   dacpo_ply_rows rows;
   if (dacpo_tool::extension(in) != ".ply" ||
