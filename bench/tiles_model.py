@@ -21,15 +21,19 @@ constant measured in that run unless marked as assumed):
            dacpo_orient() measured (busy / held points, one rank), times the
            contention of every core busy (summed busy of the widest run that
            does not oversubscribe over the one-rank run's)
-  T_join   halo normals (32 bytes each) to their owners, a T x T evidence sum
-           (16 bytes per pair) reduced to rank 0, a spanning tree (negligible)
+  T_join   halo normals (32 bytes each) to their owners; the evidence of the
+           tile pairs (24 bytes each, about 26 neighbours per tile, assumed:
+           a cell of a 3-D kd-split) gathered on rank 0; a spanning tree
+           (negligible)
   T_write  every own normal (24 bytes) to its range's rank, then each rank
            writes n / R x 24 bytes; an assumed aggregate file-system bandwidth
            (--disk, 10 GB/s shared by all ranks) bounds it
+  measured machine: R ranks share --cores cores (more ranks than cores run
+           their tiles in turn); a cluster: one core per rank
   memory per rank: its tiles' points (16 bytes each; held = n (1 + h) / R),
-           one tile's dacpo_orient() (max_points x 800 bytes, the -memory
-           budget), its range's normals (12 bytes a point) and the evidence
-           (16 T^2 bytes on rank 0)
+           one tile's dacpo_orient() (measured, scaled with the tile's
+           points), its range's normals (12 bytes a point) and, on rank 0,
+           the pair evidence
 
 The tile count follows from the budget (dacpo_tiled_points_for_memory:
 (bytes - 96 MiB) / 800 points of own + halo, cut at 0.8 of that), not from R:
@@ -70,22 +74,31 @@ def fit(runs, n, cores):
         "route_s_per_point": one["route_s"] / n,
         "tile_s_per_point": one["busy_s"] / held,
         "contention": contention,
-        "base_mb": min(x["peak_rss_mb"] - 16e-6 * x["held_points"] for r in runs.values() for x in r),
+        # a rank's peak beyond its tiles' points (16 bytes) and its range's
+        # normals (12 bytes): one tile's dacpo_orient() and the process
+        "tile_run_mb": sum(x["peak_rss_mb"] - 16e-6 * x["held_points"] - 12e-6 * n / len(r)
+                           for r in runs.values() for x in r) / sum(len(r) for r in runs.values()),
+        "tile_points": held / one["num_tiles"],
     }
 
 
-def predict(m, n, R, memory, net, disk):
+def predict(m, n, R, memory, net, disk, cores=None):
     h = m["halo_share"]
     tp = tile_points(memory)
-    T = max(1, math.ceil(n * (1 + h) / (0.8 * tp)))  # cells of about 0.8 tp own points
+    # median cuts halve a cell until it holds at most 0.8 tp own points
+    T = 2 ** max(0, math.ceil(math.log2(n / (0.8 * tp))))
     per_tile = n * (1 + h) / T
+    P = min(R, cores) if cores else R  # ranks that compute at once
     t_read = m["read_s_per_point"] * n / R
     t_route = m["route_s_per_point"] * n / R + 24.0 * n * (1 + h) / R / (net * 1e9)
-    t_tiles = math.ceil(T / R) * per_tile * m["tile_s_per_point"] * (m["contention"] if R > 1 else 1.0)
-    t_join = 32.0 * n * h / R / (net * 1e9) + 16.0 * T * T / (net * 1e9)
+    t_tiles = (math.ceil(T / R) * R / P) * per_tile * m["tile_s_per_point"] * \
+        (m["contention"] if R > 1 else 1.0)
+    t_join = 32.0 * n * h / R / (net * 1e9) + 24.0 * 26 * T / (net * 1e9)
     t_write = 24.0 * n / R / (net * 1e9) + 24.0 * n / (disk * 1e9)
-    mem = (16.0 * n * (1 + h) / R + BYTES_PER_POINT * per_tile + 12.0 * n / R) / 1e9 + m["base_mb"] / 1e3
-    mem0 = mem + 16.0 * T * T / 1e9
+    # one tile's run scales with its points (assumed proportional)
+    mem = (16.0 * n * (1 + h) / R + 12.0 * n / R) / 1e9 + \
+        m["tile_run_mb"] / 1e3 * per_tile / m["tile_points"]
+    mem0 = mem + 24.0 * 26 * T / 1e9
     return T, t_read, t_route, t_tiles, t_join, t_write, mem, mem0
 
 
@@ -103,7 +116,7 @@ def main():
     m = fit(runs, o.points, o.cores)
     print("fitted on %.3g points, %d tiles, -memory %.3g bytes" % (o.points, m["tiles"], o.memory))
     for k in ("halo_share", "read_s_per_point", "route_s_per_point", "tile_s_per_point",
-              "contention", "base_mb"):
+              "contention", "tile_run_mb", "tile_points"):
         print("  %s: %.4g" % (k, m[k]))
     print()
     print("| points | ranks | -memory | tiles | read s | route s | tiles s | join s | write s "
@@ -111,7 +124,8 @@ def main():
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n, R, mem in ([(o.points, R, o.memory) for R in sorted(runs)] +
                       [(o.predict, R, mem) for R in (64, 1024) for mem in (o.memory, 4 * 1024 ** 3)]):
-        T, a, b, c, d, e, g, g0 = predict(m, n, R, mem, o.net, o.disk)
+        T, a, b, c, d, e, g, g0 = predict(m, n, R, mem, o.net, o.disk,
+                                          o.cores if n == o.points else None)
         measured = "—"
         if n == o.points and R in runs:
             measured = "%.1f" % max(sum(x[k] for k in ("read_plan_s", "route_s", "tiles_s", "join_s",

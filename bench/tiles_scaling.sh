@@ -26,7 +26,7 @@ t0=$(date +%s.%N)
   -seed 1 -threads 2 2> "$W/one.log"
 t1=$(date +%s.%N)
 line=$(grep '^tiles:' "$W/one.log")
-tiles=$(sed -n 's/.*tiles=\([0-9]*\).*/\1/p' <<< "$line")
+tiles=$(sed -n 's/^tiles: points=[0-9]* tiles=\([0-9]*\).*/\1/p' <<< "$line")
 printf "| one process, -memory %s | 1 | %.1f | %s | %s; peak RSS %.0f MB | %s | — |\n" "$MEM" \
   "$(echo "$t1 - $t0" | bc)" "$tiles" "$(sed 's/^tiles: //' <<< "$line")" \
   "$(echo "$(cat "$W/one.rss") / 1024" | bc -l)" "$(wrong "$W/one.ply")"

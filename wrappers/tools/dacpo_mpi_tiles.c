@@ -22,7 +22,8 @@
  *
  * Memory per rank: its tiles (own + halo points, 16 bytes each, plus one
  * dacpo_orient() at a time), its range's normals (12 bytes a point), a round's
- * messages and the T x T evidence; no rank holds the whole cloud.
+ * messages and the evidence of its tiles' pairs; no rank holds the whole
+ * cloud.
  */
 #define _FILE_OFFSET_BITS 64
 #define _POSIX_C_SOURCE 200809L
@@ -356,6 +357,77 @@ route(tiles_run* t, dacpo_mpi_tiles_report* rep)
   return dacpo_mpi_all_ok(ok);
 }
 
+/* The evidence of the tile pairs seen on this rank: an open-addressing map
+ * from (a, b) to its entry (a tile borders a few dozen others, so the pairs
+ * are O(tiles), never the T x T matrix). */
+typedef struct pair_map {
+  dacpo_tile_overlap* entry;
+  size_t used, cap; /* entries */
+  int32_t* slot;    /* 2 cap slots: entry index or -1 */
+} pair_map;
+
+static int
+pair_map_init(pair_map* m, size_t tiles)
+{
+  m->used = 0;
+  m->cap = 64;
+  while (m->cap < 4 * tiles && m->cap < ((size_t)1 << 20))
+    m->cap *= 2;
+  m->entry = malloc(m->cap * sizeof(dacpo_tile_overlap));
+  m->slot = malloc(2 * m->cap * sizeof(int32_t));
+  if (m->slot)
+    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
+  return m->entry && m->slot;
+}
+
+static void
+pair_map_free(pair_map* m)
+{
+  free(m->entry);
+  free(m->slot);
+}
+
+static size_t
+pair_slot(const pair_map* m, uint32_t a, uint32_t b)
+{
+  const uint64_t key = ((uint64_t)a << 32) | b;
+  size_t i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (2 * m->cap - 1);
+  while (m->slot[i] >= 0 && (m->entry[m->slot[i]].a != a || m->entry[m->slot[i]].b != b))
+    i = (i + 1) & (2 * m->cap - 1);
+  return i;
+}
+
+/* The entry of (a, b), created empty; NULL when memory ran out. */
+static dacpo_tile_overlap*
+pair_map_get(pair_map* m, uint32_t a, uint32_t b)
+{
+  size_t i = pair_slot(m, a, b);
+  if (m->slot[i] >= 0)
+    return &m->entry[m->slot[i]];
+  if (m->used == m->cap) { /* grow: twice the entries, rehash */
+    dacpo_tile_overlap* e = realloc(m->entry, 2 * m->cap * sizeof(dacpo_tile_overlap));
+    int32_t* sl = malloc(4 * m->cap * sizeof(int32_t));
+    if (!e || !sl) {
+      if (e)
+        m->entry = e;
+      free(sl);
+      return NULL;
+    }
+    m->entry = e;
+    free(m->slot);
+    m->slot = sl;
+    m->cap *= 2;
+    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
+    for (size_t k = 0; k < m->used; ++k)
+      m->slot[pair_slot(m, m->entry[k].a, m->entry[k].b)] = (int32_t)k;
+    i = pair_slot(m, a, b);
+  }
+  const dacpo_tile_overlap z = {a, b, 0.0, 0.0};
+  m->entry[m->used] = z;
+  m->slot[i] = (int32_t)m->used++;
+  return &m->entry[m->slot[i]];
+}
+
 /* tiles + join: orient this rank's tiles; halo normals to the owners' ranks;
  * evidence summed on rank 0; flips everywhere. Own normals stay in the
  * tiles' records (xyz replaced by the normal: the position is not needed
@@ -424,8 +496,8 @@ orient_and_join(tiles_run* t,
   vec in = {NULL, 0, 0};
   ok = dacpo_mpi_all_ok(ok) && exchange(out, t->ranks, &in, &rep->traffic);
   const size_t T = t->T;
-  double* ev = calloc(2 * T * T + T, sizeof(double)); /* same, opposite, own points */
-  ok = dacpo_mpi_all_ok(ok && ev != NULL);
+  pair_map ev = {NULL, 0, 0, NULL};
+  ok = dacpo_mpi_all_ok(ok && pair_map_init(&ev, T));
   for (size_t b = 0; ok && b < in.size; b += sizeof(halo_msg)) {
     halo_msg h;
     memcpy(&h, in.data + b, sizeof(h));
@@ -447,49 +519,65 @@ orient_and_join(tiles_run* t,
     }
     const float* o = rec[lo].xyz;
     const double d = (double)h.n[0] * o[0] + (double)h.n[1] * o[1] + (double)h.n[2] * o[2];
-    ev[(d >= 0.0 ? 0 : T * T) + (size_t)h.a * T + (size_t)h.b] += fabs(d);
+    dacpo_tile_overlap* e = pair_map_get(&ev, (uint32_t)h.a, (uint32_t)h.b);
+    if (!e) {
+      fprintf(stderr, "Error (rank %d): out of memory\n", t->rank);
+      ok = 0;
+      break;
+    }
+    /* in the order tile a listed them: the same sums as in one process */
+    if (d >= 0.0)
+      e->same += fabs(d);
+    else
+      e->opposite += fabs(d);
   }
-  for (size_t k = 0; ev && k < T; ++k)
-    ev[2 * T * T + k] = (double)own_count[k];
   free(in.data);
   for (int d = 0; out && d < t->ranks; ++d)
     free(out[d].data);
   free(out);
   ok = dacpo_mpi_all_ok(ok);
   if (ok) {
-    /* sums in rank order are not needed for identity: each (a, b) entry comes
-     * from one rank only (the rank of tile b) */
-    double* sum = t->rank == 0 ? calloc(2 * T * T + T, sizeof(double)) : NULL;
-    MPI_Reduce(ev, sum, (int)(2 * T * T + T), MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-    if (t->rank == 0) {
-      dacpo_tile_overlap* ov = malloc((T > 0 ? T * T : 1) * sizeof(dacpo_tile_overlap));
-      uint64_t* pts = malloc(T * sizeof(uint64_t));
-      size_t nov = 0;
-      ok = sum && ov && pts;
-      for (size_t a = 0; ok && a < T; ++a) {
-        pts[a] = (uint64_t)sum[2 * T * T + a];
-        for (size_t b = 0; b < T; ++b) {
-          const double s = sum[a * T + b], o = sum[T * T + a * T + b];
-          if (s > 0.0 || o > 0.0) {
-            dacpo_tile_overlap e = {(uint32_t)a, (uint32_t)b, s, o};
-            ov[nov++] = e;
-          }
-        }
+    /* each (a, b) comes from one rank (tile b's): rank 0 gathers the lists,
+     * and the own points per tile (each counted on its tile's rank) */
+    double* own = calloc(T ? T : 1, sizeof(double));
+    double* own_sum = t->rank == 0 ? calloc(T ? T : 1, sizeof(double)) : NULL;
+    for (size_t k = 0; own && k < T; ++k)
+      own[k] = (double)own_count[k];
+    MPI_Reduce(own, own_sum, (int)T, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    const int bytes = (int)(ev.used * sizeof(dacpo_tile_overlap));
+    int* cnt = t->rank == 0 ? malloc(2 * (size_t)t->ranks * sizeof(int)) : NULL;
+    MPI_Gather(&bytes, 1, MPI_INT, cnt, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    size_t total = 0;
+    if (t->rank == 0)
+      for (int r = 0; r < t->ranks; ++r) {
+        cnt[t->ranks + r] = (int)total;
+        total += (size_t)cnt[r];
       }
+    dacpo_tile_overlap* all = t->rank == 0 ? malloc(total ? total : 1) : NULL;
+    MPI_Gatherv(ev.entry, bytes, MPI_BYTE, all, cnt, cnt ? cnt + t->ranks : NULL, MPI_BYTE, 0,
+                MPI_COMM_WORLD);
+    if (t->rank == 0) {
+      uint64_t* pts = malloc((T ? T : 1) * sizeof(uint64_t));
+      ok = own_sum && all && pts;
+      for (size_t k = 0; ok && k < T; ++k)
+        pts[k] = (uint64_t)own_sum[k];
       char msg[400];
-      if (ok && dacpo_tile_join(T, ov, nov, pts, flip, msg, sizeof(msg)) != DACPO_OK) {
+      if (ok && dacpo_tile_join(T, all, total / sizeof(dacpo_tile_overlap), pts, flip, msg,
+                                sizeof(msg)) != DACPO_OK) {
         fprintf(stderr, "Error: %s\n", msg);
         ok = 0;
       }
       for (size_t k = 0; ok && k < T; ++k)
         rep->flipped_tiles += flip[k];
-      free(ov);
       free(pts);
-      free(sum);
     }
+    free(all);
+    free(cnt);
+    free(own);
+    free(own_sum);
     MPI_Bcast(flip, (int)T, MPI_BYTE, 0, MPI_COMM_WORLD);
   }
-  free(ev);
+  pair_map_free(&ev);
   free(own_count);
   rep->wall[3] = now_s() - t0;
   return dacpo_mpi_all_ok(ok);
