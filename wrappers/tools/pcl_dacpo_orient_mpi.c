@@ -20,10 +20,12 @@
  * the normals are the same bytes for any number of ranks (-whole: rank 0 runs
  * dacpo_orient() itself, for comparison).
  *
- * What this does not do yet: rank 0 holds the whole cloud (the other ranks
- * hold only their units, and their slab with -spread_knn), reads it alone,
- * writes the output alone and runs stages 0-1 past the neighbour search
- * (normals, graph, blocks) alone.
+ * In this mode rank 0 holds the whole cloud (the other ranks hold only their
+ * units, and their slab with -spread_knn), reads it alone, writes the output
+ * alone and runs stages 0-1 past the neighbour search alone. -tiles P /
+ * -memory X (dacpo_mpi_tiles.c) is the mode without a whole cloud anywhere:
+ * spatial tiles, each oriented by dacpo_orient() on one rank, their signs
+ * joined from the halos; the bytes of pcl_dacpo_orient -memory for any R.
  *
  * Input: PLY (ascii or binary) or PCD (ascii, binary or binary_compressed), by
  * extension (wrappers/support/dacpo_pcd.h). Output: binary PLY (float x y z nx
