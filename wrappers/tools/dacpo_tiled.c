@@ -83,6 +83,26 @@ dacpo_tiled_sample_stride(uint64_t n)
   return n == 0 ? 1 : (n + DACPO_TILED_SAMPLE - 1) / DACPO_TILED_SAMPLE;
 }
 
+int
+dacpo_tiled_parse_size(const char* text, double* bytes)
+{
+  char* end = NULL;
+  if (!text || !bytes)
+    return 0;
+  double v = strtod(text, &end);
+  if (end == text)
+    return 0;
+  const char u = *end;
+  if (u == 'K' || u == 'k' || u == 'M' || u == 'm' || u == 'G' || u == 'g') {
+    v *= u == 'K' || u == 'k' ? 1024.0 : u == 'M' || u == 'm' ? 1048576.0 : 1073741824.0;
+    ++end;
+  }
+  if (*end != '\0' || !(v > 0.0) || !isfinite(v))
+    return 0;
+  *bytes = v;
+  return 1;
+}
+
 dacpo_params
 dacpo_tiled_params(const dacpo_params* user)
 {

@@ -67,6 +67,11 @@ dacpo_tiled_sample_stride(uint64_t n);
 dacpo_params
 dacpo_tiled_params(const dacpo_params* user);
 
+/* "4G", "512M", "100K" or a plain number of bytes -> *bytes; 0 when it is not
+ * a positive finite size. */
+int
+dacpo_tiled_parse_size(const char* text, double* bytes);
+
 /* Budget in bytes -> max points per tile (at least 16). */
 uint64_t
 dacpo_tiled_points_for_memory(double bytes);

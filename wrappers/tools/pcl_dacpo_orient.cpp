@@ -231,20 +231,12 @@ const OptionSpec kOptions[] = {
      "where their halos overlap (normals always estimated)",
      nullptr,
      [](Options& o, const std::string& s, std::string& error) {
-       double v = 0.0, unit = 1.0;
-       std::string num = s;
-       if (!num.empty()) {
-         const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(num.back())));
-         if (c == 'K' || c == 'M' || c == 'G') {
-           unit = c == 'K' ? 1024.0 : c == 'M' ? 1048576.0 : 1073741824.0;
-           num.pop_back();
-         }
-       }
-       if (!toDouble(num, v) || !(v > 0.0) || !std::isfinite(v * unit)) {
+       double v = 0.0;
+       if (!dacpo_tiled_parse_size(s.c_str(), &v)) {
          error = "expects a size such as 4G or 512M, got '" + s + "'";
          return false;
        }
-       o.memory = v * unit;
+       o.memory = v;
        if (o.memory < 2.0 * DACPO_TILED_BASE_BYTES) {
          error = "needs at least " +
                  std::to_string(static_cast<int>(2.0 * DACPO_TILED_BASE_BYTES / 1048576.0)) +

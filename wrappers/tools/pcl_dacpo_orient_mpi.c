@@ -137,23 +137,21 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         return 0;
       }
     }
-    else if ((!strcmp(a, "-memory") || !strcmp(a, "-tile_halo")) && has_value) {
-      char* end = NULL;
-      double x = strtod(argv[++i], &end);
-      const char u = *end;
-      if (a[1] == 'm' && (u == 'K' || u == 'M' || u == 'G' || u == 'k' || u == 'm' || u == 'g')) {
-        x *= u == 'K' || u == 'k' ? 1024.0 : u == 'M' || u == 'm' ? 1048576.0 : 1073741824.0;
-        ++end;
-      }
-      if (*end != '\0' || !(x > 0.0) || !isfinite(x)) {
-        snprintf(msg, msg_size, "%s needs a positive %s, got %s", a,
-                 a[1] == 'm' ? "size (e.g. 4G)" : "number", argv[i]);
+    else if (!strcmp(a, "-memory") && has_value) {
+      double x = 0.0;
+      if (!dacpo_tiled_parse_size(argv[++i], &x)) {
+        snprintf(msg, msg_size, "-memory needs a size such as 4G, got %s", argv[i]);
         return 0;
       }
-      if (a[1] == 'm')
-        o->tile_points = dacpo_tiled_points_for_memory(x);
-      else
-        o->tile_halo = x;
+      o->tile_points = dacpo_tiled_points_for_memory(x);
+    }
+    else if (!strcmp(a, "-tile_halo") && has_value) {
+      char* end = NULL;
+      o->tile_halo = strtod(argv[++i], &end);
+      if (*end != '\0' || !(o->tile_halo > 0.0) || !isfinite(o->tile_halo)) {
+        snprintf(msg, msg_size, "-tile_halo needs a positive number, got %s", argv[i]);
+        return 0;
+      }
     }
     else if (!strcmp(a, "-report") && has_value)
       o->report = argv[++i];
