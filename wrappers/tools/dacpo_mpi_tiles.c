@@ -357,77 +357,6 @@ route(tiles_run* t, dacpo_mpi_tiles_report* rep)
   return dacpo_mpi_all_ok(ok);
 }
 
-/* The evidence of the tile pairs seen on this rank: an open-addressing map
- * from (a, b) to its entry (a tile borders a few dozen others, so the pairs
- * are O(tiles), never the T x T matrix). */
-typedef struct pair_map {
-  dacpo_tile_overlap* entry;
-  size_t used, cap; /* entries */
-  int32_t* slot;    /* 2 cap slots: entry index or -1 */
-} pair_map;
-
-static int
-pair_map_init(pair_map* m, size_t tiles)
-{
-  m->used = 0;
-  m->cap = 64;
-  while (m->cap < 4 * tiles && m->cap < ((size_t)1 << 20))
-    m->cap *= 2;
-  m->entry = malloc(m->cap * sizeof(dacpo_tile_overlap));
-  m->slot = malloc(2 * m->cap * sizeof(int32_t));
-  if (m->slot)
-    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
-  return m->entry && m->slot;
-}
-
-static void
-pair_map_free(pair_map* m)
-{
-  free(m->entry);
-  free(m->slot);
-}
-
-static size_t
-pair_slot(const pair_map* m, uint32_t a, uint32_t b)
-{
-  const uint64_t key = ((uint64_t)a << 32) | b;
-  size_t i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (2 * m->cap - 1);
-  while (m->slot[i] >= 0 && (m->entry[m->slot[i]].a != a || m->entry[m->slot[i]].b != b))
-    i = (i + 1) & (2 * m->cap - 1);
-  return i;
-}
-
-/* The entry of (a, b), created empty; NULL when memory ran out. */
-static dacpo_tile_overlap*
-pair_map_get(pair_map* m, uint32_t a, uint32_t b)
-{
-  size_t i = pair_slot(m, a, b);
-  if (m->slot[i] >= 0)
-    return &m->entry[m->slot[i]];
-  if (m->used == m->cap) { /* grow: twice the entries, rehash */
-    dacpo_tile_overlap* e = realloc(m->entry, 2 * m->cap * sizeof(dacpo_tile_overlap));
-    int32_t* sl = malloc(4 * m->cap * sizeof(int32_t));
-    if (!e || !sl) {
-      if (e)
-        m->entry = e;
-      free(sl);
-      return NULL;
-    }
-    m->entry = e;
-    free(m->slot);
-    m->slot = sl;
-    m->cap *= 2;
-    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
-    for (size_t k = 0; k < m->used; ++k)
-      m->slot[pair_slot(m, m->entry[k].a, m->entry[k].b)] = (int32_t)k;
-    i = pair_slot(m, a, b);
-  }
-  const dacpo_tile_overlap z = {a, b, 0.0, 0.0};
-  m->entry[m->used] = z;
-  m->slot[i] = (int32_t)m->used++;
-  return &m->entry[m->slot[i]];
-}
-
 /* tiles + join: orient this rank's tiles; halo normals to the owners' ranks;
  * evidence summed on rank 0; flips everywhere. Own normals stay in the
  * tiles' records (xyz replaced by the normal: the position is not needed
@@ -496,8 +425,8 @@ orient_and_join(tiles_run* t,
   vec in = {NULL, 0, 0};
   ok = dacpo_mpi_all_ok(ok) && exchange(out, t->ranks, &in, &rep->traffic);
   const size_t T = t->T;
-  pair_map ev = {NULL, 0, 0, NULL};
-  ok = dacpo_mpi_all_ok(ok && pair_map_init(&ev, T));
+  dacpo_tile_pairs ev = {NULL, 0, 0, NULL};
+  ok = dacpo_mpi_all_ok(ok && dacpo_tile_pairs_init(&ev, T));
   for (size_t b = 0; ok && b < in.size; b += sizeof(halo_msg)) {
     halo_msg h;
     memcpy(&h, in.data + b, sizeof(h));
@@ -519,7 +448,7 @@ orient_and_join(tiles_run* t,
     }
     const float* o = rec[lo].xyz;
     const double d = (double)h.n[0] * o[0] + (double)h.n[1] * o[1] + (double)h.n[2] * o[2];
-    dacpo_tile_overlap* e = pair_map_get(&ev, (uint32_t)h.a, (uint32_t)h.b);
+    dacpo_tile_overlap* e = dacpo_tile_pairs_get(&ev, (uint32_t)h.a, (uint32_t)h.b);
     if (!e) {
       fprintf(stderr, "Error (rank %d): out of memory\n", t->rank);
       ok = 0;
@@ -577,7 +506,7 @@ orient_and_join(tiles_run* t,
     free(own_sum);
     MPI_Bcast(flip, (int)T, MPI_BYTE, 0, MPI_COMM_WORLD);
   }
-  pair_map_free(&ev);
+  dacpo_tile_pairs_free(&ev);
   free(own_count);
   rep->wall[3] = now_s() - t0;
   return dacpo_mpi_all_ok(ok);

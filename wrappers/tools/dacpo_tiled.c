@@ -15,7 +15,7 @@
  *             temporary output onto the output
  *
  * Peak memory: the sample (12 bytes x 200K), one chunk, one tile's
- * dacpo_orient() run, and the T x T evidence. Disk: 20 bytes per routed point,
+ * dacpo_orient() run, and the evidence per tile pair. Disk: 20 bytes per routed point,
  * 24 per halo point, the output. Errors leave no output and no temporary file.
  */
 #define _FILE_OFFSET_BITS 64
@@ -411,14 +411,74 @@ run_tile(tiled_run* r, size_t t, dacpo_ctx* ctx, dacpo_tiled_report* rep, char* 
   return rc;
 }
 
+int
+dacpo_tile_pairs_init(dacpo_tile_pairs* m, size_t tiles)
+{
+  m->used = 0;
+  m->cap = 64;
+  while (m->cap < 4 * tiles && m->cap < ((size_t)1 << 20))
+    m->cap *= 2;
+  m->entry = malloc(m->cap * sizeof(dacpo_tile_overlap));
+  m->slot = malloc(2 * m->cap * sizeof(int32_t));
+  if (m->slot)
+    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
+  return m->entry && m->slot;
+}
+
+void
+dacpo_tile_pairs_free(dacpo_tile_pairs* m)
+{
+  free(m->entry);
+  free(m->slot);
+}
+
+static size_t
+pair_slot(const dacpo_tile_pairs* m, uint32_t a, uint32_t b)
+{
+  const uint64_t key = ((uint64_t)a << 32) | b;
+  size_t i = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (2 * m->cap - 1);
+  while (m->slot[i] >= 0 && (m->entry[m->slot[i]].a != a || m->entry[m->slot[i]].b != b))
+    i = (i + 1) & (2 * m->cap - 1);
+  return i;
+}
+
+dacpo_tile_overlap*
+dacpo_tile_pairs_get(dacpo_tile_pairs* m, uint32_t a, uint32_t b)
+{
+  size_t i = pair_slot(m, a, b);
+  if (m->slot[i] >= 0)
+    return &m->entry[m->slot[i]];
+  if (m->used == m->cap) { /* grow: twice the entries, rehash */
+    dacpo_tile_overlap* e = realloc(m->entry, 2 * m->cap * sizeof(dacpo_tile_overlap));
+    int32_t* sl = malloc(4 * m->cap * sizeof(int32_t));
+    if (!e || !sl) {
+      if (e)
+        m->entry = e;
+      free(sl);
+      return NULL;
+    }
+    m->entry = e;
+    free(m->slot);
+    m->slot = sl;
+    m->cap *= 2;
+    memset(m->slot, 0xff, 2 * m->cap * sizeof(int32_t));
+    for (size_t k = 0; k < m->used; ++k)
+      m->slot[pair_slot(m, m->entry[k].a, m->entry[k].b)] = (int32_t)k;
+    i = pair_slot(m, a, b);
+  }
+  const dacpo_tile_overlap z = {a, b, 0.0, 0.0};
+  m->entry[m->used] = z;
+  m->slot[i] = (int32_t)m->used++;
+  return &m->entry[m->slot[i]];
+}
+
 /* Pass 4: halo normals against their owners' -> evidence -> flips. */
 static int
 join(tiled_run* r, uint8_t* flip, dacpo_tiled_report* rep, char* err, size_t errlen)
 {
   const size_t T = r->T;
-  double* same = calloc(T * T, sizeof(double));
-  double* opp = calloc(T * T, sizeof(double));
-  int rc = same && opp ? 0 : fail(err, errlen, "out of memory for %zu x %zu tiles", T, T);
+  dacpo_tile_pairs ev = {NULL, 0, 0, NULL};
+  int rc = dacpo_tile_pairs_init(&ev, T) ? 0 : fail(err, errlen, "out of memory");
   if (rc == 0 && (fflush(r->halo_file) != 0 || fseeko(r->halo_file, 0, SEEK_SET) != 0))
     rc = fail(err, errlen, "cannot read back the halo file");
   unsigned char rec[HALO_BYTES];
@@ -434,34 +494,28 @@ join(tiled_run* r, uint8_t* flip, dacpo_tiled_report* rep, char* err, size_t err
       break;
     }
     const int32_t owner = dacpo_tile_locate(r->plan, o, NULL, 0, NULL);
-    const double d = (double)n[0] * o[3] + (double)n[1] * o[4] + (double)n[2] * o[5];
     if (owner < 0 || (size_t)owner >= T || t < 0 || (size_t)t >= T) {
       rc = fail(err, errlen, "internal: halo record of point %llu", (unsigned long long)idx);
       break;
     }
-    (d >= 0.0 ? same : opp)[(size_t)t * T + (size_t)owner] += fabs(d);
-  }
-  dacpo_tile_overlap* ov = NULL;
-  size_t nov = 0;
-  if (rc == 0) {
-    ov = malloc((T * T > 0 ? T * T : 1) * sizeof(dacpo_tile_overlap));
-    if (!ov)
+    const double d = (double)n[0] * o[3] + (double)n[1] * o[4] + (double)n[2] * o[5];
+    dacpo_tile_overlap* e = dacpo_tile_pairs_get(&ev, (uint32_t)t, (uint32_t)owner);
+    if (!e) {
       rc = fail(err, errlen, "out of memory");
+      break;
+    }
+    if (d >= 0.0)
+      e->same += fabs(d);
+    else
+      e->opposite += fabs(d);
   }
-  for (size_t a = 0; rc == 0 && a < T; ++a)
-    for (size_t b = 0; b < T; ++b)
-      if (same[a * T + b] > 0.0 || opp[a * T + b] > 0.0) {
-        dacpo_tile_overlap e = {(uint32_t)a, (uint32_t)b, same[a * T + b], opp[a * T + b]};
-        ov[nov++] = e;
-      }
   char msg[400];
-  if (rc == 0 && dacpo_tile_join(T, ov, nov, r->own_count, flip, msg, sizeof(msg)) != DACPO_OK)
+  if (rc == 0 &&
+      dacpo_tile_join(T, ev.entry, ev.used, r->own_count, flip, msg, sizeof(msg)) != DACPO_OK)
     rc = fail(err, errlen, "%s", msg);
   for (size_t t = 0; rc == 0 && t < T; ++t)
     rep->flipped_tiles += flip[t];
-  free(ov);
-  free(same);
-  free(opp);
+  dacpo_tile_pairs_free(&ev);
   return rc;
 }
 

@@ -72,6 +72,26 @@ dacpo_tiled_params(const dacpo_params* user);
 int
 dacpo_tiled_parse_size(const char* text, double* bytes);
 
+/* The evidence of tile pairs, summed as halo normals meet their owners': an
+ * open-addressing map from (a, b) to its dacpo_tile_overlap (a tile borders a
+ * few dozen others, so the pairs are O(tiles), never a T x T matrix). Zero-
+ * initialise, then _init; entry[0 .. used) is the list for dacpo_tile_join(). */
+typedef struct dacpo_tile_pairs {
+  dacpo_tile_overlap* entry;
+  size_t used, cap; /* entries */
+  int32_t* slot;    /* 2 cap slots: entry index or -1 */
+} dacpo_tile_pairs;
+
+int
+dacpo_tile_pairs_init(dacpo_tile_pairs* m, size_t tiles);
+
+/* The entry of (a, b), created empty; NULL when memory ran out. */
+dacpo_tile_overlap*
+dacpo_tile_pairs_get(dacpo_tile_pairs* m, uint32_t a, uint32_t b);
+
+void
+dacpo_tile_pairs_free(dacpo_tile_pairs* m);
+
 /* Budget in bytes -> max points per tile (at least 16). */
 uint64_t
 dacpo_tiled_points_for_memory(double bytes);
