@@ -51,6 +51,10 @@ unit_dipole_params(const dacpo_params* p, size_t b, uint8_t* thin, int8_t* cue)
   dp.restarts = p->dipole_restarts;
   dp.restart_vote = p->dipole_restart_vote;
   dp.sides = p->dipole_sides;
+  /* Many views: thin parts show both faces anywhere; 32 neighbours fit the
+   * faces of narrow boards (shelves 6 samples deep) better than 24. */
+  dp.sides_everywhere = p->scan_kind == DACPO_SCAN_MULTI_VIEW;
+  dp.sides_fit_k = p->scan_kind == DACPO_SCAN_MULTI_VIEW ? 32 : 24;
   dp.thin_out = thin;
   dp.cue_out = cue;
   return dp;

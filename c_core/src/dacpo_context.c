@@ -97,12 +97,13 @@ dacpo_params_init(dacpo_params* p)
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
   p->dipole_two_sheet = 3.0;
-  p->dipole_layers = 2.0;
+  p->dipole_layers = -1.0;
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
   p->dipole_c_thin = 4.0;
   p->normal_weight = 0.0;
   p->adaptive_normals = 1;
+  p->scan_kind = DACPO_SCAN_AUTO;
 }
 
 static dacpo_status
@@ -247,11 +248,15 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_c_thin must be finite and >= 0 (got %g)",
                      p->dipole_c_thin);
-  if (!(p->dipole_layers >= 0.0) || !isfinite(p->dipole_layers))
+  if (!isfinite(p->dipole_layers))
     return bad_field(message,
                      size,
-                     "dipole_layers must be finite and >= 0 (got %g)",
+                     "dipole_layers must be finite (got %g; < 0 = by the scan kind)",
                      p->dipole_layers);
+  if (p->scan_kind != DACPO_SCAN_AUTO && p->scan_kind != DACPO_SCAN_SINGLE_VIEW &&
+      p->scan_kind != DACPO_SCAN_MULTI_VIEW)
+    return bad_field(
+        message, size, "scan_kind has an unknown value %d", (int)p->scan_kind);
   if (!(p->dipole_sides >= 0.0) || !isfinite(p->dipole_sides))
     return bad_field(message,
                      size,

@@ -489,6 +489,8 @@ side_field(const double* xyz,
            const double* nrm,
            size_t n,
            size_t K,
+           size_t fit_k,
+           int everywhere,
            double weight,
            double spacing,
            dipole_work* wk,
@@ -512,11 +514,18 @@ side_field(const double* xyz,
     return DACPO_OOM(err);
   size_t fired = 0;
   dacpo_status st =
-      dacpo_sheet_side(xyz, nrm, n, wk->nb, K, spacing, wk->unary, face, &fired, err);
-  if ((double)fired < DACPO_SIDE_MIN_SHARE * (double)n)
-    memset(wk->unary, 0, n * sizeof(double)); /* one-sided block: no cue */
-  else if (st == DACPO_OK)
+      dacpo_sheet_side(
+          xyz, nrm, n, wk->nb, K, fit_k, spacing, wk->unary, face, &fired, err);
+  /* Below the share the block may be one depth view's noise: no cue at all,
+   * unless the scene is known to be seen from many places; then its pairs
+   * still face opposite ways, but the cue neither fixes the points through
+   * stage 3 nor anchors the block in stage 5 (a scanned room's air gaps, a
+   * radiator off a wall, fire it wrongly on a few points of a block). */
+  const int shared = (double)fired >= DACPO_SIDE_MIN_SHARE * (double)n;
+  if (st == DACPO_OK && (shared || everywhere))
     side_pairs(xyz, nrm, n, K, wk, face);
+  if (!shared)
+    memset(wk->unary, 0, n * sizeof(double));
   free(face);
   for (size_t i = 0; st == DACPO_OK && i < n; ++i) {
     double mag = 0.0;
@@ -580,7 +589,16 @@ dipole_neighbors(const double* xyz,
     }
   }
   if (st == DACPO_OK && prm->sides > 0.0)
-    st = side_field(xyz, nrm, n, K, prm->sides, ts.spacing, wk, err);
+    st = side_field(xyz,
+                    nrm,
+                    n,
+                    K,
+                    prm->sides_fit_k,
+                    prm->sides_everywhere,
+                    prm->sides,
+                    ts.spacing,
+                    wk,
+                    err);
   free(ts.noise);
   free(ts.local);
   free(ts.sheet);

@@ -33,6 +33,12 @@ typedef struct dacpo_dipole_params {
                         noise get this c (dacpo_params.dipole_c_thin) */
   double sides;      /* 0 = off; else weight of the thin-part side cue
                         (dacpo_sheet_side.h; dacpo_params.dipole_sides) */
+  int sides_everywhere; /* 1: every block gets the side cue (a scene seen from
+                           many places); 0: only blocks where >= 5 % of the
+                           points show it (a single depth view, whose noise
+                           fires it on up to 3.5 % of a block) */
+  size_t sides_fit_k;   /* neighbours of the cue's surface fit, <=
+                           DACPO_SIDE_MAX_NEIGHBORS (0: 24) */
   uint8_t* thin_out; /* optional output (n entries, may be NULL): 1 where the
                         side cue fired, i.e. the point lies on a part thinner
                         than the block's Poisson grid resolves (stage 3 keeps

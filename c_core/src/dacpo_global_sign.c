@@ -51,6 +51,7 @@
 #include "dacpo_global_sign.h"
 
 #include "dacpo_part_sign.h"
+#include "dacpo_view_kind.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -65,7 +66,7 @@ enum {
 #define GS_TIE 0.01
 #define GS_VIS_TIE 0.01
 #define GS_ENCLOSED 0.9
-#define GS_DENSITY_FIT 0.5
+#define GS_DENSITY_FIT DACPO_SINGLE_VIEW_FIT
 
 typedef struct gs_candidate {
   double v[3];
@@ -190,35 +191,6 @@ ray_coverage(const dacpo_view_sample* s, const double v[3], double radius)
   return (double)blocked / (double)GS_RAYS;
 }
 
-/* How well v explains the sampling density: the Pearson correlation, over
- * the sample, of log density (-2 log of the k-th neighbour distance) with
- * log(cos(incidence) / r^2), the density a sensor at v produces (a depth
- * image samples equal solid angles). logd: m log densities. */
-static double
-density_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
-{
-  double sx = 0.0, sy = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0;
-  for (size_t i = 0; i < s->m; ++i) {
-    const double d[3] = {
-        v[0] - s->p[3 * i], v[1] - s->p[3 * i + 1], v[2] - s->p[3 * i + 2]};
-    const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    const double* q = s->n + 3 * i;
-    const double c =
-        fabs(q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / sqrt(fmax(r2, 1e-300));
-    const double x = log(fmax(c, 0.05)) - log(fmax(r2, 1e-300));
-    const double y = logd[i];
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    syy += y * y;
-    sxy += x * y;
-  }
-  const double m = (double)s->m;
-  const double cov = sxy - sx * sy / m;
-  const double vx = sxx - sx * sx / m, vy = syy - sy * sy / m;
-  return vx > 0.0 && vy > 0.0 ? cov / sqrt(vx * vy) : 0.0;
-}
-
 /* Sample spacing: the two largest box extents spread over the sample. */
 static double
 gs_sample_spacing(const dacpo_view_sample* vs)
@@ -251,21 +223,13 @@ gs_pick(const dacpo_view_sample* vs,
   size_t best = 0;
   double best_vis = -1.0;
   double* vis = malloc(tied * sizeof(double));
-  double* logd = knn_sqd && knn_k > 0 ? malloc(vs->m * sizeof(double)) : NULL;
+  double* logd =
+      knn_sqd && knn_k > 0 ? dacpo_view_log_density(vs, knn_sqd, knn_k, knn_k) : NULL;
   if (!vis || (knn_sqd && knn_k > 0 && !logd)) {
     free(logd);
     free(vis);
     return -1;
   }
-  if (logd)
-    for (size_t i = 0; i < vs->m; ++i) {
-      const float* row = knn_sqd + i * vs->stride * knn_k;
-      double far = 0.0;
-      for (size_t j = 0; j < knn_k; ++j) /* absent neighbours are +inf */
-        if (isfinite(row[j]))
-          far = fmax(far, (double)row[j]);
-      logd[i] = -log(fmax(far, 1e-300)); /* -2 log r_k */
-    }
   for (size_t t = 0; t < tied; ++t) {
     vis[t] = visible_share(vs, cand[t].v, spacing, cell);
     if (vis[t] < 0.0) {
@@ -285,7 +249,7 @@ gs_pick(const dacpo_view_sample* vs,
   if (logd) {
     double best_fit = GS_DENSITY_FIT;
     for (size_t t = 0; t < tied; ++t) {
-      const double fit = density_fit(vs, logd, cand[t].v);
+      const double fit = dacpo_view_density_fit(vs, logd, cand[t].v);
       if (fit > best_fit) {
         best_fit = fit;
         best = t;

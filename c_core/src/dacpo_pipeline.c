@@ -27,6 +27,7 @@
 #include "dacpo_scene_mesh.h"
 #include "dacpo_segment.h"
 #include "dacpo_vcr.h"
+#include "dacpo_view_kind.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -931,6 +932,27 @@ job_fail(dacpo_ctx* ctx, dacpo_status status, dacpo_err* err)
   return dacpo_ctx_fail(ctx, err);
 }
 
+/* Stage 0: the scan kind (dacpo_view_kind.c) and the stage-2 setting it
+ * implies. Resolved here, once, so that every work unit (in this process or
+ * another) reads the same resolved parameters. */
+static dacpo_status
+resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  st->single_view_fit = 0.0;
+  if (s->p.scan_kind == DACPO_SCAN_AUTO) {
+    double fit = 0.0;
+    DACPO_TRY(dacpo_single_view_fit(
+        s->cloud.xyz, s->cloud.nrm, s->cloud.n, s->knn.sqd, s->knn.k, &fit, err));
+    st->single_view_fit = fit;
+    s->p.scan_kind =
+        fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
+  }
+  if (s->p.dipole_layers < 0.0) /* layers 0.5 spacings apart are depth steps */
+    s->p.dipole_layers = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW ? 0.5 : 2.0;
+  st->scan_kind = s->p.scan_kind;
+  return DACPO_OK;
+}
+
 /* Input and stages 0-1. normals: the given axes (estimate_normals 0); with
  * out_buffer set they are also the buffer the run writes to, which must exist
  * even when the normals are estimated. */
@@ -968,6 +990,7 @@ job_prepare(dacpo_job* job,
   DACPO_TRY(stage_done(job, DACPO_STAGE_NEIGHBORS, err));
   if (s->p.estimate_normals)
     DACPO_TRY(estimate_normals(s, err));
+  DACPO_TRY(resolve_scan_kind(s, st, err));
   DACPO_TRY(stage_done(job, DACPO_STAGE_NORMALS, err));
   DACPO_TRY(segment_blocks(s, st, err));
   DACPO_TRY(alloc_block_results(s, err));

@@ -51,7 +51,7 @@
 #include <math.h>
 #include <string.h>
 
-#define SIDE_NEIGHBORS 24  /* nearest considered (of the K given) */
+#define SIDE_NEIGHBORS 24  /* nearest considered by default (of the K given) */
 #define SIDE_MIN_COS 0.8   /* parallel axes: |a.b| above this */
 #define SIDE_MIN_POINTS 12 /* points needed for the 6-term fit */
 #define SIDE_MIN_CLUSTER 0.25
@@ -162,7 +162,7 @@ surface_fit(const double* u,
 static double
 otsu_split(const double* r, int m, double* threshold, double* gap)
 {
-  double s[SIDE_NEIGHBORS + 1];
+  double s[DACPO_SIDE_MAX_NEIGHBORS + 1];
   for (int k = 0; k < m; ++k) { /* insertion sort: m <= 25 */
     int j = k;
     while (j > 0 && s[j - 1] > r[k]) {
@@ -229,7 +229,7 @@ static int
 one_surface_split(
     const double* u, const double* v, const double* z, int m, double spacing, double* l)
 {
-  double r[SIDE_NEIGHBORS + 1], c[7], thr = 0.0, gap = 0.0;
+  double r[DACPO_SIDE_MAX_NEIGHBORS + 1], c[7], thr = 0.0, gap = 0.0;
   if (!surface_fit(u, v, z, NULL, m, c, r))
     return -1;
   const double sep = otsu_split(r, m, &thr, &gap);
@@ -258,7 +258,7 @@ two_copy_fit(const double* u,
              double* l,
              double* gap_out)
 {
-  double r[SIDE_NEIGHBORS + 1], c[7], gap = 0.0, sep = 0.0;
+  double r[DACPO_SIDE_MAX_NEIGHBORS + 1], c[7], gap = 0.0, sep = 0.0;
   const int kmin = (int)ceil(SIDE_MIN_CLUSTER * (double)m);
   for (int it = 0; it < SIDE_FIT_ROUNDS; ++it) {
     if (!surface_fit(u, v, z, l, m, c, r))
@@ -332,6 +332,7 @@ point_side(const double* xyz,
            size_t i,
            const int32_t* row,
            size_t K,
+           size_t fit_k,
            double spacing,
            int8_t* face,
            int* strict)
@@ -340,13 +341,13 @@ point_side(const double* xyz,
   const double* a = nrm + 3 * i;
   double e1[3], e2[3];
   tangent_frame(a, e1, e2);
-  double u[SIDE_NEIGHBORS + 1], v[SIDE_NEIGHBORS + 1], z[SIDE_NEIGHBORS + 1];
-  double l[SIDE_NEIGHBORS + 1];
-  size_t slot[SIDE_NEIGHBORS + 1]; /* index t in row of fitted point k */
+  double u[DACPO_SIDE_MAX_NEIGHBORS + 1], v[DACPO_SIDE_MAX_NEIGHBORS + 1], z[DACPO_SIDE_MAX_NEIGHBORS + 1];
+  double l[DACPO_SIDE_MAX_NEIGHBORS + 1];
+  size_t slot[DACPO_SIDE_MAX_NEIGHBORS + 1]; /* index t in row of fitted point k */
   int m = 1;
   u[0] = v[0] = z[0] = 0.0; /* the point itself */
   double lateral = 0.0;
-  const size_t kk = K < SIDE_NEIGHBORS ? K : SIDE_NEIGHBORS;
+  const size_t kk = K < fit_k ? K : fit_k;
   for (size_t t = 0; t < kk; ++t) {
     const size_t j = (size_t)row[t];
     const double* b = nrm + 3 * j;
@@ -389,6 +390,7 @@ dacpo_sheet_side(const double* xyz,
                  size_t n,
                  const int32_t* nb,
                  size_t K,
+                 size_t fit_k,
                  double spacing,
                  double* side,
                  int8_t* face,
@@ -402,13 +404,21 @@ dacpo_sheet_side(const double* xyz,
               DACPO_ERR_INVALID_ARGUMENT,
               "sheet side: NULL array for %zu points",
               n);
+  if (fit_k == 0)
+    fit_k = SIDE_NEIGHBORS;
+  DACPO_CHECK(err,
+              fit_k <= DACPO_SIDE_MAX_NEIGHBORS,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "sheet side: fit_k %zu above %d",
+              fit_k,
+              DACPO_SIDE_MAX_NEIGHBORS);
   if (face)
     memset(face, 0, n * K);
   size_t count = 0;
   for (size_t i = 0; i < n; ++i) {
     int one = 0;
     side[i] = point_side(
-        xyz, nrm, i, nb + i * K, K, spacing, face ? face + i * K : NULL, &one);
+        xyz, nrm, i, nb + i * K, K, fit_k, spacing, face ? face + i * K : NULL, &one);
     count += (size_t)one;
   }
   if (strict)

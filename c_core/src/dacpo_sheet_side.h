@@ -12,6 +12,8 @@
  *
  * xyz, nrm: 3n doubles (unit axes); nb: n x K nearest neighbours of every point
  * (self excluded, nearest first; rows padded with the point itself are allowed);
+ * fit_k: how many of the K nearest the surface fit considers (at most
+ * DACPO_SIDE_MAX_NEIGHBORS; 0 = 24);
  * spacing: the block's typical nearest-neighbour distance.
  * face (n x K, may be NULL): where the cue fires, face[i K + t] = +1 if nb[i K + t]
  * lies on point i's own face, -1 on the other face, 0 if it was not part of the
@@ -23,6 +25,7 @@
  *
  * Failures: none beyond INVALID_ARGUMENT for NULL arrays (pure arithmetic). */
 #define SIDE_HIDDEN (-2)
+#define DACPO_SIDE_MAX_NEIGHBORS 32
 
 dacpo_status
 dacpo_sheet_side(const double* xyz,
@@ -30,6 +33,7 @@ dacpo_sheet_side(const double* xyz,
                  size_t n,
                  const int32_t* nb,
                  size_t K,
+                 size_t fit_k,
                  double spacing,
                  double* side,
                  int8_t* face,

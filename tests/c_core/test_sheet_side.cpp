@@ -92,6 +92,7 @@ runCue(const Cloud& c, std::vector<int8_t>* face_out, std::vector<int32_t>* nb_o
                              n,
                              nb.data(),
                              kK,
+                             0,
                              kH,
                              side.data(),
                              face.data(),
@@ -323,10 +324,10 @@ TEST(DacpoSheetSide, EmptyAndNullInput)
 {
   dacpo_err err{};
   EXPECT_EQ(dacpo_sheet_side(
-                nullptr, nullptr, 0, nullptr, kK, kH, nullptr, nullptr, nullptr, &err),
+                nullptr, nullptr, 0, nullptr, kK, 0, kH, nullptr, nullptr, nullptr, &err),
             DACPO_OK);
   double side = 0.0;
   EXPECT_EQ(dacpo_sheet_side(
-                nullptr, nullptr, 1, nullptr, kK, kH, &side, nullptr, nullptr, &err),
+                nullptr, nullptr, 1, nullptr, kK, 0, kH, &side, nullptr, nullptr, &err),
             DACPO_ERR_INVALID_ARGUMENT);
 }

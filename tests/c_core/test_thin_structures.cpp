@@ -228,8 +228,10 @@ TEST(DacpoThinStructures, ThinObjects)
 // 2.5 cm spacing), default parameters (side cue 0.001): its blocks hold
 // two-sided parts, so pairs lying off each other's tangent plane beyond the
 // two-sheet noise test use c = 4 (dacpo_params.dipole_c_thin) instead of the
-// noise-resistant 1.5. Measured worst of seeds 1-3, % wrong: c_thin 4 (default)
-// 3.95, c_thin 0 8.55.
+// noise-resistant 1.5. Measured worst of seeds 1-3, % wrong: with the side cue
+// only in blocks where >= 5 % of the points show it, c_thin 4 3.95, c_thin 0
+// 8.55; since the scene counts as seen from many places (scan_kind AUTO: its
+// density fits no sensor) every block gets the cue's pairs: 1.19 and 1.58.
 TEST(DacpoThinStructures, NoisyPartitionUsesTheCleanConstantOnGeometry)
 {
   const SceneCase on = {DACPO_SCENE_PARTITION, 55000, 0.005, 0.0, 0.001};
@@ -242,6 +244,6 @@ TEST(DacpoThinStructures, NoisyPartitionUsesTheCleanConstantOnGeometry)
          worst_off);
   RecordProperty("worst_percent_c_thin", std::to_string(worst_on));
   RecordProperty("worst_percent_c_thin_off", std::to_string(worst_off));
-  EXPECT_LE(worst_on, 4.5);
-  EXPECT_LT(worst_on, worst_off - 2.0);
+  EXPECT_LE(worst_on, 2.0);
+  EXPECT_LE(worst_off, 2.5);
 }

@@ -63,6 +63,7 @@ defaultParams()
   d["dipole_restart_vote"] = p.dipole_restart_vote;
   d["weak_edge_fraction"] = p.weak_edge_fraction;
   d["sign_policy"] = static_cast<int>(p.sign_policy);
+  d["scan_kind"] = static_cast<int>(p.scan_kind);
   d["viewpoint"] = py::make_tuple(p.viewpoint[0], p.viewpoint[1], p.viewpoint[2]);
   return d;
 }
@@ -115,6 +116,7 @@ toParams(const py::dict& d)
   p.weak_edge_fraction = get<double>(d, "weak_edge_fraction", p.weak_edge_fraction);
   p.sign_policy =
       static_cast<dacpo_sign_policy>(get<int>(d, "sign_policy", p.sign_policy));
+  p.scan_kind = static_cast<dacpo_scan_kind>(get<int>(d, "scan_kind", p.scan_kind));
   if (d.contains("viewpoint")) {
     const py::tuple v = py::tuple(d["viewpoint"]);
     for (int i = 0; i < 3; ++i)
@@ -215,6 +217,8 @@ statsDict(const dacpo_stats* s)
   stats["sign_flipped"] = s->sign_flipped != 0;
   stats["sign_facing"] = s->sign_facing;
   stats["sign_enclosed"] = s->sign_enclosed != 0;
+  stats["scan_kind"] = s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
+  stats["single_view_fit"] = s->single_view_fit;
   stats["total_seconds"] = s->total_seconds;
   py::dict stage_seconds;
   for (int i = 0; i < DACPO_STAGE_COUNT; ++i)

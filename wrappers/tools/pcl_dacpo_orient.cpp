@@ -331,9 +331,31 @@ const OptionSpec kOptions[] = {
      "X",
      "layered one-sided surfaces: parallel neighbours off each\n"
      "other's tangent plane by more than X local spacings are\n"
-     "layers of one surface (no \"opposite\" vote), 0 = off",
+     "layers of one surface (no \"opposite\" vote), 0 = off,\n"
+     "-1 = by the scan kind (0.5 single view, 2 otherwise)",
      showNumber<double, &dacpo_params::dipole_layers>,
      setDouble<&dacpo_params::dipole_layers>},
+    {"-scan",
+     "auto|single|multi",
+     "kind of scan: one depth view (single: layers face one way,\n"
+     "no thin part shows two faces) or seen from many places\n"
+     "(multi: fused scans, sampled models; the thin-part side cue\n"
+     "in every block); auto decides from the sampling density\n"
+     "(default: auto)",
+     nullptr,
+     [](Options& o, const std::string& s, std::string& error) {
+       if (s == "auto")
+         o.params.scan_kind = DACPO_SCAN_AUTO;
+       else if (s == "single")
+         o.params.scan_kind = DACPO_SCAN_SINGLE_VIEW;
+       else if (s == "multi")
+         o.params.scan_kind = DACPO_SCAN_MULTI_VIEW;
+       else {
+         error = "expects auto, single or multi, got '" + s + "'";
+         return false;
+       }
+       return true;
+     }},
     {"-sides",
      "X",
      "thin parts under one spacing: weight of the side cue (the\n"
@@ -1185,7 +1207,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "cue_anchored=%zu parts_cue_signed=%zu "
+               "cue_anchored=%zu parts_cue_signed=%zu scan=%s single_view_fit=%.3f "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1200,6 +1222,8 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.flipped_blocks,
                s.cue_anchored_blocks,
                s.parts_cue_signed,
+               s.scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single" : "multi",
+               s.single_view_fit,
                s.sign_flipped,
                s.sign_facing,
                s.sign_enclosed,

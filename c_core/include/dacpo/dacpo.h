@@ -114,6 +114,21 @@ typedef enum dacpo_disconnected_policy {
 } dacpo_disconnected_policy;
 
 /** \brief Which of the two consistent orientations the run returns. */
+/** \brief What kind of scan the cloud is; stage 2 reads thin parts and layers
+ *  differently for each. */
+typedef enum dacpo_scan_kind {
+  /** Decide from the cloud: one depth view when a sensor position explains its
+   *  sampling density (dacpo_stats::single_view_fit >= 0.5). */
+  DACPO_SCAN_AUTO = 0,
+  /** One depth view (an organized frame, a Kinect-class capture): every surface
+   *  is seen from one side; layers a few spacings apart face the same way. */
+  DACPO_SCAN_SINGLE_VIEW = 1,
+  /** Seen from many places (a fused or registered scan, a sampled model, a room
+   *  scanned from inside): thin parts show both faces, which look away from
+   *  each other. */
+  DACPO_SCAN_MULTI_VIEW = 2
+} dacpo_scan_kind;
+
 typedef enum dacpo_sign_policy {
   /** Normals face the free space the scene was seen from: the viewpoint
    *  that most normals face and that sees most of the scene (normals face
@@ -208,10 +223,9 @@ typedef struct dacpo_params {
                                       (dipole_two_sheet). Measured (0.5-2 spacings):
                                       such pairs face the same way in 98-99.8 % of
                                       cases on single depth frames, the opposite way in
-                                      72-97 % on rooms with thin parts. Seeds 1-5: 2
-                                      (default): 15 depth frames 4.80 -> 3.66 % wrong,
-                                      18 rooms 7.95 -> 8.01 %; 0.5 (single-view depth
-                                      data): frames 2.72 %, rooms 8.30 %. 0 = off */
+                                      72-97 % on rooms with thin parts. < 0 = by the
+                                      scan kind: 0.5 for a single view, 2 otherwise
+                                      (-1); 0 = off */
   double dipole_sides;           /**< stage 2, parts thinner than the spacing (a
                                       board 0.3-1 spacing thick): where a point's
                                       parallel neighbours lie on two copies of one
@@ -272,6 +286,14 @@ typedef struct dacpo_params {
                                       18 rooms, % wrong (worst seed): 0 2.20
                                       (2.42) / 5.82 (6.27); 1 2.03 (2.54) /
                                       5.20 (5.63) (1) */
+  dacpo_scan_kind scan_kind;     /**< single depth view or many views (AUTO: decided
+                                      from the sampling density, see
+                                      dacpo_stats::scan_kind). A single view keeps
+                                      the side cue (dipole_sides) to blocks where
+                                      >= 5 % of the points show a second face and
+                                      reads layers at 0.5 spacings; many views give
+                                      every block the cue, fitted over 32
+                                      neighbours instead of 24 (AUTO) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -363,6 +385,10 @@ typedef struct dacpo_stats {
                                    (dacpo_params.cue_anchor) */
   size_t parts_cue_signed;    /**< parts (not the largest) whose sign the cue
                                    turned after the viewpoint vote and stage 6 */
+  dacpo_scan_kind scan_kind;  /**< the kind the run used (never AUTO) */
+  double single_view_fit;     /**< AUTO: how well one sensor position explains the
+                                   sampling density (correlation, -1..1; >= 0.5:
+                                   single view); 0 when the kind was given */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -621,13 +621,13 @@ public:
     return params_.dipole_c_thin;
   }
 
-  /** \brief Layered surfaces seen from one side (default 2, 0 = off; 0.5 for
-   * single-view depth data): neighbours with parallel axes more than this many local
-   * spacings off each other's tangent plane are layers of one surface (depth
-   * quantisation) and no longer vote for opposite orientations (Eq. 1 with c = 1),
-   * in blocks where under 3 % of the points have a second sheet beneath them.
-   * Measured (15 depth frames / 18 synthetic rooms, % wrong): off 4.80 / 7.95,
-   * 2 3.66 / 8.01, 0.5 2.72 / 8.30. */
+  /** \brief Layered surfaces seen from one side (default -1: by the scan kind,
+   * 0.5 for a single depth view, 2 otherwise; 0 = off): neighbours with parallel
+   * axes more than this many local spacings off each other's tangent plane are
+   * layers of one surface (depth quantisation) and no longer vote for opposite
+   * orientations (Eq. 1 with c = 1), in blocks where under 3 % of the points have
+   * a second sheet beneath them. Measured (15 depth frames / 18 synthetic rooms,
+   * % wrong, one value for both): off 4.80 / 7.95, 2 3.66 / 8.01, 0.5 2.72 / 8.30. */
   void
   setDipoleLayers(double spacings)
   {
@@ -638,6 +638,24 @@ public:
   getDipoleLayers() const
   {
     return params_.dipole_layers;
+  }
+
+  /** \brief The kind of scan (default DACPO_SCAN_AUTO: decided from the sampling
+   * density, see dacpo_stats::scan_kind): DACPO_SCAN_SINGLE_VIEW for one depth
+   * frame (layers face one way; the thin-part side cue only where a block shows
+   * it clearly), DACPO_SCAN_MULTI_VIEW for fused scans and sampled scenes (the
+   * side cue in every block). Set it for a depth frame thinned to a coarse voxel
+   * grid, which no longer looks like one view. */
+  void
+  setScanKind(dacpo_scan_kind kind)
+  {
+    params_.scan_kind = kind;
+  }
+  /** \brief See setScanKind(). */
+  dacpo_scan_kind
+  getScanKind() const
+  {
+    return params_.scan_kind;
   }
 
   /** \brief Parts thinner than the point spacing (default 0.001, 0 = off; 0.5

@@ -24,7 +24,9 @@ __version__ = _core.version
 _EDGE_WEIGHTS = {"dipole": 0, "vcr": 1, "overlap": 2}
 _DISCONNECTED = {"separate": 0, "error": 1, "bridge": 2, "viewpoint": 3}
 _SIGN = {"free_space": 0, "viewpoint": 1, "keep": 2}
-_ENUMS = {"edge_weight": _EDGE_WEIGHTS, "disconnected": _DISCONNECTED, "sign_policy": _SIGN}
+_SCAN = {"auto": 0, "single_view": 1, "multi_view": 2}
+_ENUMS = {"edge_weight": _EDGE_WEIGHTS, "disconnected": _DISCONNECTED, "sign_policy": _SIGN,
+          "scan_kind": _SCAN}
 _ALIASES = {"threads": "num_threads"}
 
 
@@ -70,6 +72,7 @@ def default_params():
     d["edge_weight"] = names[d["edge_weight"]]
     d["disconnected"] = {v: k for k, v in _DISCONNECTED.items()}[d["disconnected"]]
     d["sign_policy"] = {v: k for k, v in _SIGN.items()}[d["sign_policy"]]
+    d["scan_kind"] = {v: k for k, v in _SCAN.items()}[d["scan_kind"]]
     d["threads"] = d.pop("num_threads")
     return d
 
@@ -166,6 +169,7 @@ def orient(points, normals=None, *, progress=None, **params):
               lists them): ``k=10``, ``seed=1``, ``threads=0`` (all cores),
               ``num_blocks=0`` (automatic), ``dipole_c=1.5``,
               ``edge_weight='vcr'``, ``sign_policy='free_space'``,
+              ``scan_kind='auto'`` (or ``'single_view'``, ``'multi_view'``),
               ``viewpoint=(x, y, z)`` (then normals face it), ...
 
     Returns an (N, 3) float32 array of unit normals in the input order and an

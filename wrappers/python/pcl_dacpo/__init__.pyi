@@ -51,6 +51,7 @@ def orient(
     dipole_restarts: int = ...,
     weak_edge_fraction: float = ...,
     sign_policy: Union[str, int] = ...,
+    scan_kind: Union[str, int] = ...,
     viewpoint: Sequence[float] = ...,
 ) -> Tuple[npt.NDArray[np.float32], OrientResult]: ...
 def orient_o3d(pcd: Any, **params: Any) -> OrientResult: ...
