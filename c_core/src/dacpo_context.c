@@ -75,7 +75,7 @@ dacpo_params_init(dacpo_params* p)
   p->estimate_normals = 0;
   p->num_blocks = 0;
   p->ring_hops = 3;
-  p->dipole_c = 1.5;
+  p->dipole_c = -1.0;
   p->dipole_orders = 5;
   p->dipole_neighbors = 32;
   p->dipole_final_sweep = 10;
@@ -145,10 +145,11 @@ check_graph(const dacpo_params* p, char* message, size_t size)
 static dacpo_status
 check_dipole_counts(const dacpo_params* p, char* message, size_t size)
 {
-  if (!(p->dipole_c > 1.0) || !isfinite(p->dipole_c))
+  if (!(p->dipole_c >= 1.0 || p->dipole_c < 0.0) || !isfinite(p->dipole_c))
     return bad_field(message,
                      size,
-                     "dipole_c must be finite and > 1 (paper Eq. 1), got %g",
+                     "dipole_c must be finite and >= 1 (paper Eq. 1; < 0: by the scan "
+                     "kind), got %g",
                      p->dipole_c);
   if (p->dipole_orders < 1 || p->dipole_orders > 16)
     return bad_field(

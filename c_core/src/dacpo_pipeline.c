@@ -947,8 +947,15 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
     s->p.scan_kind =
         fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
   }
+  const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;
   if (s->p.dipole_layers < 0.0) /* layers 0.5 spacings apart are depth steps */
-    s->p.dipole_layers = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW ? 0.5 : 2.0;
+    s->p.dipole_layers = single ? 0.5 : 2.0;
+  /* One view shows no part from both sides: c = 1 drops Eq. 1's stacked vote
+   * ("opposite"), which there is only ever noise or layers. */
+  if (s->p.dipole_c < 0.0)
+    s->p.dipole_c = single ? 1.0 : 1.5;
+  st->dipole_c_used = s->p.dipole_c;
+  st->dipole_layers_used = s->p.dipole_layers;
   st->scan_kind = s->p.scan_kind;
   return DACPO_OK;
 }

@@ -552,7 +552,7 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
     void (*set)(dacpo_params*);
   };
   const Case cases[] = {
-      {"dipole_c", [](dacpo_params* p) { p->dipole_c = 1.0; }},
+      {"dipole_c", [](dacpo_params* p) { p->dipole_c = 0.5; }},
       {"dipole_c", [](dacpo_params* p) { p->dipole_c = std::nan(""); }},
       {"solver_time_limit",
        [](dacpo_params* p) { p->solver_time_limit = std::nan(""); }},

@@ -224,7 +224,11 @@ TEST(DacpoViewKind, TooFewPointsAndNullArguments)
 
 // The pipeline decides the kind once, reports it, and keeps a given one.
 dacpo_stats
-runOn(const Cloud& c, dacpo_scan_kind kind)
+runOn(const Cloud& c,
+      dacpo_scan_kind kind,
+      std::vector<float>* normals = nullptr,
+      double dipole_c = -1.0,
+      double layers = -1.0)
 {
   std::vector<float> xyz(c.xyz.begin(), c.xyz.end()), nrm(c.xyz.size());
   dacpo_params p;
@@ -232,6 +236,8 @@ runOn(const Cloud& c, dacpo_scan_kind kind)
   p.estimate_normals = 1;
   p.num_threads = 2;
   p.scan_kind = kind;
+  p.dipole_c = dipole_c;
+  p.dipole_layers = layers;
   dacpo_ctx* ctx = nullptr;
   EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
   EXPECT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, xyz.data(), nrm.data(), c.size()),
@@ -239,6 +245,8 @@ runOn(const Cloud& c, dacpo_scan_kind kind)
       << dacpo_ctx_last_error(ctx);
   const dacpo_stats s = *dacpo_ctx_stats(ctx);
   dacpo_ctx_free(ctx);
+  if (normals)
+    *normals = nrm;
   return s;
 }
 
@@ -263,12 +271,31 @@ TEST(DacpoViewKind, PipelineReportsTheKind)
   EXPECT_EQ(given.single_view_fit, 0.0);
 }
 
+// What the kind sets when c and the layer rule are left to it (-1): a single
+// view runs with c = 1 and layers at 0.5 spacings, a scene seen from many
+// places with c = 1.5 and layers at 2; given values are kept.
+TEST(DacpoViewKind, KindSetsDipoleConstantAndLayers)
+{
+  const Cloud frame = depthFrame();
+  const dacpo_stats single = runOn(frame, DACPO_SCAN_AUTO);
+  EXPECT_EQ(single.dipole_c_used, 1.0);
+  EXPECT_EQ(single.dipole_layers_used, 0.5);
+  const dacpo_stats multi = runOn(frame, DACPO_SCAN_MULTI_VIEW);
+  EXPECT_EQ(multi.dipole_c_used, 1.5);
+  EXPECT_EQ(multi.dipole_layers_used, 2.0);
+  const dacpo_stats given = runOn(frame, DACPO_SCAN_AUTO, nullptr, 2.5, 1.0);
+  EXPECT_EQ(given.scan_kind, DACPO_SCAN_SINGLE_VIEW);
+  EXPECT_EQ(given.dipole_c_used, 2.5);
+  EXPECT_EQ(given.dipole_layers_used, 1.0);
+}
+
 TEST(DacpoViewKind, ParamsRejectUnknownKindAndNonFiniteLayers)
 {
   dacpo_params p;
   dacpo_params_init(&p);
   EXPECT_EQ(p.scan_kind, DACPO_SCAN_AUTO);
   EXPECT_LT(p.dipole_layers, 0.0);
+  EXPECT_LT(p.dipole_c, 0.0);
   char msg[256];
   p.scan_kind = static_cast<dacpo_scan_kind>(7);
   EXPECT_EQ(dacpo_params_validate(&p, msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);

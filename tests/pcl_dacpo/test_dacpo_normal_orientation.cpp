@@ -467,7 +467,7 @@ TEST(DACPONormalOrientation, BadParametersAndNormalsSizeAreReported)
   pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal> dacpo;
   skipIPSR(dacpo);
   dacpo.setInputCloud(scene.cloud);
-  dacpo.setDipoleC(0.5); // paper Eq. 1 needs c > 1
+  dacpo.setDipoleC(0.5); // paper Eq. 1 needs c >= 1 (or < 0: by the scan kind)
   EXPECT_EQ(dacpo.getDipoleC(), 0.5);
   pcl::PointCloud<pcl::Normal> out;
   dacpo.compute(out);

@@ -219,6 +219,8 @@ statsDict(const dacpo_stats* s)
   stats["sign_enclosed"] = s->sign_enclosed != 0;
   stats["scan_kind"] = s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
   stats["single_view_fit"] = s->single_view_fit;
+  stats["dipole_c_used"] = s->dipole_c_used;
+  stats["dipole_layers_used"] = s->dipole_layers_used;
   stats["total_seconds"] = s->total_seconds;
   py::dict stage_seconds;
   for (int i = 0; i < DACPO_STAGE_COUNT; ++i)

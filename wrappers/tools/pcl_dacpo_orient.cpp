@@ -188,7 +188,8 @@ const OptionSpec kOptions[] = {
      setUnsigned<size_t, &dacpo_params::num_blocks>},
     {"-c",
      "X",
-     "dipole constant c (paper Eq. 1): 4 clean, 2 noisy,\n1.2-1.5 depth frames",
+     "dipole constant c (paper Eq. 1), >= 1: 4 clean, 2 noisy;\n"
+     "-1 = by the scan kind (1 single view, 1.5 otherwise)",
      showNumber<double, &dacpo_params::dipole_c>,
      setDouble<&dacpo_params::dipole_c>},
     {"-vcr_size",
@@ -1207,7 +1208,8 @@ orientFile(const std::string& in, const std::string& out, const Options& options
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "cue_anchored=%zu parts_cue_signed=%zu scan=%s single_view_fit=%.3f "
+               "cue_anchored=%zu parts_cue_signed=%zu scan=%s single_view_fit=%.3f c=%g "
+               "layers=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1224,6 +1226,8 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.parts_cue_signed,
                s.scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single" : "multi",
                s.single_view_fit,
+               s.dipole_c_used,
+               s.dipole_layers_used,
                s.sign_flipped,
                s.sign_facing,
                s.sign_enclosed,

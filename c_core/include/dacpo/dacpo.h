@@ -154,14 +154,20 @@ typedef struct dacpo_params {
   size_t num_blocks;    /**< target number of blocks; 0 = automatic:
                              n/1250 clamped to [1, 200] (default 0) */
   size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
-  double dipole_c;      /**< c of paper Eq. 1 (1.5). The paper uses 4 for clean and
-                             2 for noisy scans. Larger c keeps the two sides of
-                             thin structures apart, smaller c resists depth noise.
-                             Measured here (full pipeline): c = 4 left 22.9 % wrong
-                             on the largest components of our 15 real depth frames
-                             and 26 % on a room with noise 0.008; c = 1.5 kept a
-                             2 cm board at 20K points (0.01 % wrong) that c = 1.2
-                             got 9 % wrong. */
+  double dipole_c;      /**< c of paper Eq. 1 (-1: by the scan kind, 1 for a single
+                             depth view, 1.5 otherwise; values >= 1). The paper
+                             uses 4 for clean and 2 for noisy scans. Larger c
+                             keeps the two sides of thin structures apart, smaller
+                             c resists depth noise; c = 1 leaves only the
+                             tangential alignment n.(I - r r^T).m, no "stacked,
+                             so opposite" vote - right where no part is seen from
+                             both sides. Measured here (full pipeline): c = 4 left
+                             22.9 % wrong on the largest components of our 15 real
+                             depth frames and 26 % on a room with noise 0.008;
+                             c = 1.5 kept a 2 cm board at 20K points (0.01 %
+                             wrong) that c = 1.2 got 9 % wrong; on the 15 frames
+                             (single views, seeds 1-5) c = 1 1.65 % against 1.82 %
+                             at 1.5. */
   size_t dipole_orders; /**< M randomized BFS orders (5) */
   size_t dipole_neighbors;    /**< K nearest placed points summed per decision (32) */
   int dipole_final_sweep;     /**< re-decision sweeps after voting, repeated until no
@@ -389,6 +395,8 @@ typedef struct dacpo_stats {
   double single_view_fit;     /**< AUTO: how well one sensor position explains the
                                    sampling density (correlation, -1..1; >= 0.5:
                                    single view); 0 when the kind was given */
+  double dipole_c_used;       /**< dipole_c the run used (resolved when < 0) */
+  double dipole_layers_used;  /**< dipole_layers the run used (resolved when < 0) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

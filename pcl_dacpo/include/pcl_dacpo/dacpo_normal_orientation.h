@@ -260,9 +260,10 @@ public:
     return params_.ring_hops;
   }
 
-  /** \brief Constant c of the dipole field (paper Eq. 1), > 1 (default 1.5). Larger
-   * values keep thin two-sided structures apart, smaller ones (e.g. 1.2 for
-   * single-view depth frames) resist noise. */
+  /** \brief Constant c of the dipole field (paper Eq. 1), >= 1 (default -1: by
+   * the scan kind, 1 for a single depth view, 1.5 otherwise). Larger values keep
+   * thin two-sided structures apart, smaller ones resist noise; 1 drops the
+   * stacked term's "opposite" vote (no part of one view shows two faces). */
   void
   setDipoleC(double c)
   {

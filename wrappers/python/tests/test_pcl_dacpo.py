@@ -65,6 +65,21 @@ def test_viewpoint_and_keep_policies():
 
 # ---- parameters and inputs ------------------------------------------------------
 
+def test_scan_kind_is_decided_reported_and_can_be_given():
+    pts, gt = pcl_dacpo.make_scene("room", 8000, seed=5)
+    normals, res = pcl_dacpo.orient(pts, ipsr_enabled=False)
+    assert res.stats["scan_kind"] == "multi_view"
+    assert res.stats["single_view_fit"] < 0.5
+    assert res.stats["dipole_c_used"] == 1.5 and res.stats["dipole_layers_used"] == 2.0
+    _, single = pcl_dacpo.orient(pts, scan_kind="single_view", ipsr_enabled=False)
+    assert single.stats["scan_kind"] == "single_view"
+    assert single.stats["single_view_fit"] == 0.0
+    assert single.stats["dipole_c_used"] == 1.0 and single.stats["dipole_layers_used"] == 0.5
+    assert pcl_dacpo.default_params()["scan_kind"] == "auto"
+    with pytest.raises(ValueError, match="scan_kind must be one of"):
+        pcl_dacpo.orient(pts, scan_kind="depth")
+
+
 def test_unknown_parameter_names_the_nearest():
     pts, _ = pcl_dacpo.make_scene("plane", 500)
     with pytest.raises(TypeError, match="'kk'.*did you mean 'k'"):
