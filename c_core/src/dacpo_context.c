@@ -96,7 +96,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_restart_vote = 1;
   p->weak_edge_fraction = 1.0;
   p->sign_policy = DACPO_SIGN_FREE_SPACE;
-  p->dipole_two_sheet = 3.0;
+  p->dipole_two_sheet = -1.0;
   p->dipole_layers = -1.0;
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
@@ -229,10 +229,10 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_noise_band must be finite and >= 0 (got %g)",
                      p->dipole_noise_band);
-  if (!(p->dipole_two_sheet >= 0.0) || !isfinite(p->dipole_two_sheet))
+  if (!isfinite(p->dipole_two_sheet))
     return bad_field(message,
                      size,
-                     "dipole_two_sheet must be finite and >= 0 (got %g)",
+                     "dipole_two_sheet must be finite (got %g; < 0 = by the scan kind)",
                      p->dipole_two_sheet);
   if (!(p->normal_weight >= 0.0) || !isfinite(p->normal_weight))
     return bad_field(message,

@@ -249,7 +249,7 @@ gs_pick(const dacpo_view_sample* vs,
   if (logd) {
     double best_fit = GS_DENSITY_FIT;
     for (size_t t = 0; t < tied; ++t) {
-      const double fit = dacpo_view_density_fit(vs, logd, cand[t].v);
+      const double fit = dacpo_view_density_fit(vs, logd, cand[t].v, NULL);
       if (fit > best_fit) {
         best_fit = fit;
         best = t;

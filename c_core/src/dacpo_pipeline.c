@@ -940,9 +940,9 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   st->single_view_fit = 0.0;
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
-    double fit = 0.0;
+    double fit = 0.0, slope = 0.0;
     DACPO_TRY(dacpo_single_view_fit(
-        s->cloud.xyz, s->cloud.nrm, s->cloud.n, s->knn.sqd, s->knn.k, &fit, err));
+        s->cloud.xyz, s->cloud.nrm, s->cloud.n, s->knn.sqd, s->knn.k, &fit, &slope, err));
     st->single_view_fit = fit;
     s->p.scan_kind =
         fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
@@ -954,6 +954,10 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
    * ("opposite"), which there is only ever noise or layers. */
   if (s->p.dipole_c < 0.0)
     s->p.dipole_c = single ? 1.0 : 1.5;
+  /* ... and the two-sheet rule, whose pairs there are layers or noise. */
+  if (s->p.dipole_two_sheet < 0.0)
+    s->p.dipole_two_sheet = single ? 0.0 : 3.0;
+  st->dipole_two_sheet_used = s->p.dipole_two_sheet;
   st->dipole_c_used = s->p.dipole_c;
   st->dipole_layers_used = s->p.dipole_layers;
   st->scan_kind = s->p.scan_kind;

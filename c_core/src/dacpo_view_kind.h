@@ -11,7 +11,10 @@
  * logarithms over the sample s for a sensor at v (the axes' sign does not
  * matter). logd: s->m log densities (dacpo_view_log_density). */
 double
-dacpo_view_density_fit(const dacpo_view_sample* s, const double* logd, const double v[3]);
+dacpo_view_density_fit(const dacpo_view_sample* s,
+                       const double* logd,
+                       const double v[3],
+                       double* slope);
 
 /* logd[i] = -2 log r_k of sample point i, r_k the farthest of its first use_k
  * neighbours (knn_sqd: the cloud's n x row_k squared distances, nearest first,
@@ -25,10 +28,13 @@ dacpo_view_log_density(const dacpo_view_sample* s,
 /* *fit: the best density fit over DACPO_VIEW_KIND_CANDIDATES candidate sensors
  * (sample points pushed along either side of their axis, as the part signs'
  * viewpoints), densities from the 8th neighbour (knn_sqd: n x knn_k, nearest
- * first; fewer if knn_k < 8). A single depth frame has a sensor that explains it: 0.75-0.98 on
- * the 15 real frames of our evaluation set; rooms sampled uniformly or from
- * several places inside stay at 0.08-0.38 (18 rooms), a fused TSDF fragment at
- * 0.17. xyz, axes: n points and unit axes (3n each).
+ * first; fewer if knn_k < 8). A single depth frame has a sensor that explains
+ * it: 0.72-0.98 on the 15 real frames of our evaluation set; rooms sampled
+ * uniformly or from several places inside correlate at 0.08-0.38 (18 rooms), a
+ * fused TSDF fragment at 0.17, but with slopes of 0.08-0.11, so they get 0:
+ * candidates whose density follows the model with a regression slope under
+ * DACPO_SINGLE_VIEW_SLOPE do not count. *slope (may be NULL) gets the chosen
+ * one's. xyz, axes: n points and unit axes (3n each).
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_single_view_fit(const double* xyz,
@@ -37,10 +43,14 @@ dacpo_single_view_fit(const double* xyz,
                       const float* knn_sqd,
                       size_t knn_k,
                       double* fit,
+                      double* slope,
                       dacpo_err* err);
 
 /* The fit from which a cloud counts as one depth view (the global sign uses the
  * same threshold to single out a sensor). */
 #define DACPO_SINGLE_VIEW_FIT 0.5
+/* The least slope of log density on the sensor model for a candidate to count
+ * (dacpo_single_view_fit). */
+#define DACPO_SINGLE_VIEW_SLOPE 0.4
 
 #endif

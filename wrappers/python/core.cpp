@@ -221,6 +221,7 @@ statsDict(const dacpo_stats* s)
   stats["single_view_fit"] = s->single_view_fit;
   stats["dipole_c_used"] = s->dipole_c_used;
   stats["dipole_layers_used"] = s->dipole_layers_used;
+  stats["dipole_two_sheet_used"] = s->dipole_two_sheet_used;
   stats["total_seconds"] = s->total_seconds;
   py::dict stage_seconds;
   for (int i = 0; i < DACPO_STAGE_COUNT; ++i)

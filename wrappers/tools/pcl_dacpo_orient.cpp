@@ -318,7 +318,8 @@ const OptionSpec kOptions[] = {
      "X",
      "thin parts: neighbours off each other's tangent plane by\n"
      "more than X times the local noise are two sheets that\n"
-     "face opposite ways, 0 = off",
+     "face opposite ways, 0 = off, -1 = by the scan kind\n"
+     "(0 single view, 3 otherwise)",
      showNumber<double, &dacpo_params::dipole_two_sheet>,
      setDouble<&dacpo_params::dipole_two_sheet>},
     {"-c_thin",
@@ -1209,7 +1210,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "cue_anchored=%zu parts_cue_signed=%zu scan=%s single_view_fit=%.3f c=%g "
-               "layers=%g "
+               "layers=%g two_sheet=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1228,6 +1229,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.single_view_fit,
                s.dipole_c_used,
                s.dipole_layers_used,
+               s.dipole_two_sheet_used,
                s.sign_flipped,
                s.sign_facing,
                s.sign_enclosed,

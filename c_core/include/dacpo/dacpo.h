@@ -217,7 +217,9 @@ typedef struct dacpo_params {
                                       one side of a point and all around beneath it,
                                       is the two faces of one thin part and must face
                                       opposite ways (Eq. 1 alone aligns them for c < 3).
-                                      0 = off, the paper's field (3) */
+                                      0 = off, the paper's field; < 0 = by the scan
+                                      kind: 0 for a single depth view (no part of one
+                                      view shows two faces), 3 otherwise (-1) */
   double dipole_layers;          /**< stage 2, layered surfaces seen from one side:
                                       neighbours with near-parallel axes lying off each
                                       other's tangent plane by more than this many local
@@ -397,6 +399,7 @@ typedef struct dacpo_stats {
                                    single view); 0 when the kind was given */
   double dipole_c_used;       /**< dipole_c the run used (resolved when < 0) */
   double dipole_layers_used;  /**< dipole_layers the run used (resolved when < 0) */
+  double dipole_two_sheet_used; /**< dipole_two_sheet the run used (resolved when < 0) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

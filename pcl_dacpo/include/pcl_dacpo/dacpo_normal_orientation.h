@@ -588,7 +588,8 @@ public:
     return params_.dipole_noise_band;
   }
 
-  /** \brief Thin two-sided parts (default 3, 0 = off): neighbours with parallel axes
+  /** \brief Thin two-sided parts (default -1: by the scan kind, 0 for a single depth
+   * view, 3 otherwise; 0 = off): neighbours with parallel axes
    * that lie off each other's tangent plane by more than this many times the local
    * noise (and 0.5 to 2 local spacings), beneath one another, are taken as the two
    * faces of one thin part and made to face opposite ways. */

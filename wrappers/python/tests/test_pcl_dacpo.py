@@ -75,6 +75,7 @@ def test_scan_kind_is_decided_reported_and_can_be_given():
     assert single.stats["scan_kind"] == "single_view"
     assert single.stats["single_view_fit"] == 0.0
     assert single.stats["dipole_c_used"] == 1.0 and single.stats["dipole_layers_used"] == 0.5
+    assert single.stats["dipole_two_sheet_used"] == 0.0
     assert pcl_dacpo.default_params()["scan_kind"] == "auto"
     with pytest.raises(ValueError, match="scan_kind must be one of"):
         pcl_dacpo.orient(pts, scan_kind="depth")
