@@ -40,4 +40,31 @@ dacpo_sheet_side(const double* xyz,
                  size_t* strict,
                  dacpo_err* err);
 
+/* The same test pooled over planar patches (parallel axes grown over the first
+ * 12 neighbours of nb, within 12 spacings) whose points are noisy (median of
+ * noise[i], the point's local noise scale, at least 2.5 % of the spacing; clean
+ * data is left to the test above): where a patch's offsets are clearly
+ * two parallel copies of one quadric 0.25-1.5 spacings apart, each point of it
+ * whose own cue is silent (side[i] == 0) gets conf[i] in [-1, 1] \ {0}, signed
+ * as side[] (its face looks away from the other copy), and its face row (as
+ * above: +1 own copy, -1 other copy, 0 outside the patch); every other point
+ * conf[i] = 0 and its row untouched. field (may be NULL): where conf[i] != 0,
+ * how far to trust its sign, in [0, 1] (the patch's separation on the point
+ * test's ramp, 5 to 8: noisy copies relate their points, clear ones also say
+ * which way a face looks); 0 elsewhere. fired: points given a conf.
+ * Failures: OOM; INVALID_ARGUMENT for NULL arrays. */
+dacpo_status
+dacpo_sheet_patches(const double* xyz,
+                    const double* nrm,
+                    size_t n,
+                    const int32_t* nb,
+                    size_t K,
+                    double spacing,
+                    const double* noise,
+                    const double* side,
+                    double* conf,
+                    double* field,
+                    int8_t* face,
+                    size_t* fired,
+                    dacpo_err* err);
 #endif

@@ -6,6 +6,7 @@
 // terraces of a quantised depth image).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -106,6 +107,24 @@ runCue(const Cloud& c, std::vector<int8_t>* face_out, std::vector<int32_t>* nb_o
   return side;
 }
 
+// Face labels of point i's row: how many, and how many name the right face.
+void
+countFaceLabels(const Cloud& c,
+                const std::vector<int8_t>& face,
+                const std::vector<int32_t>& nb,
+                size_t i,
+                size_t* labels,
+                size_t* right)
+{
+  for (size_t k = 0; k < kK; ++k) {
+    if (face[i * kK + k] == 0)
+      continue;
+    ++*labels;
+    const size_t j = (size_t)nb[i * kK + k];
+    *right += (face[i * kK + k] > 0) == (c.face[i] == c.face[j]);
+  }
+}
+
 double
 firedShare(const std::vector<double>& side)
 {
@@ -162,13 +181,7 @@ TEST(DacpoSheetSide, BoardThinnerThanTheSpacing)
     const double* a = &c.axis[3 * i];
     const double* o = &c.out[3 * i];
     right += (side[i] > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
-    for (size_t k = 0; k < kK; ++k) {
-      if (face[i * kK + k] == 0)
-        continue;
-      ++labels;
-      const size_t j = (size_t)nb[i * kK + k];
-      labels_right += (face[i * kK + k] > 0) == (c.face[i] == c.face[j]);
-    }
+    countFaceLabels(c, face, nb, i, &labels, &labels_right);
   }
   printf("board 0.5 h: cue fires on %.2f %% of the points, right on %.2f %%; "
          "%.3f %% of %zu face labels right\n",
@@ -323,11 +336,199 @@ TEST(DacpoSheetSide, SilentOnSingleSurfaces)
 TEST(DacpoSheetSide, EmptyAndNullInput)
 {
   dacpo_err err{};
-  EXPECT_EQ(dacpo_sheet_side(
-                nullptr, nullptr, 0, nullptr, kK, 0, kH, nullptr, nullptr, nullptr, &err),
-            DACPO_OK);
+  EXPECT_EQ(
+      dacpo_sheet_side(
+          nullptr, nullptr, 0, nullptr, kK, 0, kH, nullptr, nullptr, nullptr, &err),
+      DACPO_OK);
   double side = 0.0;
   EXPECT_EQ(dacpo_sheet_side(
                 nullptr, nullptr, 1, nullptr, kK, 0, kH, &side, nullptr, nullptr, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
+}
+
+namespace {
+
+// Runs the point test, then the patch test on the points it left silent;
+// returns the patch confidences, face rows in *face_out.
+std::vector<double>
+runPatches(const Cloud& c,
+           std::vector<double>* side_out,
+           std::vector<int8_t>* face_out,
+           std::vector<int32_t>* nb_out)
+{
+  std::vector<int8_t> face;
+  std::vector<int32_t> nb;
+  const std::vector<double> side = runCue(c, &face, &nb);
+  // local noise scale as stage 2 takes it: 25th percentile of the 16 nearest
+  // offsets from the point's tangent plane
+  std::vector<double> noise(c.size());
+  for (size_t i = 0; i < c.size(); ++i) {
+    std::vector<double> off;
+    for (size_t k = 0; k < 16; ++k) {
+      const size_t j = (size_t)nb[i * kK + k];
+      double o = 0.0;
+      for (int d = 0; d < 3; ++d)
+        o += (c.xyz[3 * j + d] - c.xyz[3 * i + d]) * c.axis[3 * i + d];
+      off.push_back(std::fabs(o));
+    }
+    std::nth_element(off.begin(), off.begin() + 4, off.end());
+    noise[i] = off[4];
+  }
+  std::vector<double> conf(c.size(), -1.0);
+  size_t fired = 0;
+  dacpo_err err{};
+  EXPECT_EQ(dacpo_sheet_patches(c.xyz.data(),
+                                c.axis.data(),
+                                c.size(),
+                                nb.data(),
+                                kK,
+                                kH,
+                                noise.data(),
+                                side.data(),
+                                conf.data(),
+                                nullptr,
+                                face.data(),
+                                &fired,
+                                &err),
+            DACPO_OK);
+  size_t given = 0;
+  for (double v : conf)
+    given += v != 0.0;
+  EXPECT_EQ(given, fired);
+  if (side_out)
+    *side_out = side;
+  if (face_out)
+    *face_out = face;
+  if (nb_out)
+    *nb_out = nb;
+  return conf;
+}
+
+// A board t thick (faces +z at z = t, -z at 0), noise sigma along z.
+Cloud
+board(double t, double sigma)
+{
+  Cloud c;
+  addSheet(
+      c,
+      0.6,
+      [t](double, double, double* n, int) {
+        n[2] = 1.0;
+        return t;
+      },
+      1,
+      sigma,
+      21);
+  addSheet(
+      c,
+      0.6,
+      [](double, double, double* n, int) {
+        n[2] = -1.0;
+        return 0.0;
+      },
+      -1,
+      sigma,
+      22);
+  return c;
+}
+
+} // namespace
+
+// An 18 mm board at 2 cm spacing with 4.6 mm noise along its axis (what
+// sigma = 8 mm in random directions leaves along it): the faces are four noise
+// deviations apart, too close for the point test, clear over a patch.
+TEST(DacpoSheetSide, PatchesFindANoisyBoard)
+{
+  const Cloud c = board(0.9 * kH, 0.23 * kH);
+  std::vector<double> side;
+  std::vector<int8_t> face;
+  std::vector<int32_t> nb;
+  const std::vector<double> conf = runPatches(c, &side, &face, &nb);
+  size_t point_fired = 0, patch_fired = 0, side_right = 0, labels = 0, labels_right = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    point_fired += side[i] != 0.0;
+    if (conf[i] == 0.0)
+      continue;
+    ++patch_fired;
+    const double* a = &c.axis[3 * i];
+    const double* o = &c.out[3 * i];
+    side_right += (conf[i] > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
+    countFaceLabels(c, face, nb, i, &labels, &labels_right);
+  }
+  printf("noisy 0.9 h board: point test fires on %.2f %%, patches on %.2f %% of the "
+         "points, side right on %.2f %%; %.2f %% of %zu face labels right\n",
+         100.0 * point_fired / c.size(),
+         100.0 * patch_fired / c.size(),
+         100.0 * side_right / patch_fired,
+         100.0 * labels_right / labels,
+         labels);
+  EXPECT_LE((double)point_fired, 0.20 * (double)c.size()); // 15 % measured
+  EXPECT_GE((double)patch_fired, 0.80 * (double)c.size());
+  EXPECT_GE((double)side_right, 0.95 * (double)patch_fired);
+  EXPECT_GE((double)labels_right, 0.90 * (double)labels);
+}
+
+// One noisy sheet is not two faces; a clean thin board is left to the point
+// test (the patch test reads noise, and on clean data would only add pairs
+// across joints).
+TEST(DacpoSheetSide, PatchesSilentOnOneNoisySheetAndOnCleanData)
+{
+  Cloud one;
+  addSheet(one, 0.6, flat, 0, 0.23 * kH, 23);
+  const Cloud noisy_two_sheets_apart = [] {
+    Cloud c;
+    addSheet(c, 0.6, flat, 0, 0.23 * kH, 24);
+    addSheet(c, 0.6, flat, 0, 0.23 * kH, 25);
+    return c;
+  }();
+  const Cloud clean = board(0.9 * kH, 0.0);
+  struct Case {
+    const char* name;
+    const Cloud* cloud;
+  } cases[] = {{"one noisy sheet", &one},
+               {"twice as dense", &noisy_two_sheets_apart},
+               {"clean board", &clean}};
+  for (const Case& k : cases) {
+    const std::vector<double> conf = runPatches(*k.cloud, nullptr, nullptr, nullptr);
+    size_t fired = 0;
+    for (double v : conf)
+      fired += v != 0.0;
+    printf("%-16s patches fire on %zu of %zu points\n", k.name, fired, k.cloud->size());
+    EXPECT_EQ(fired, 0u) << k.name;
+  }
+}
+
+TEST(DacpoSheetSide, PatchesRefuseNullInput)
+{
+  dacpo_err err{};
+  size_t fired = 1;
+  EXPECT_EQ(dacpo_sheet_patches(nullptr,
+                                nullptr,
+                                0,
+                                nullptr,
+                                kK,
+                                kH,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                &fired,
+                                &err),
+            DACPO_OK);
+  EXPECT_EQ(fired, 0u);
+  EXPECT_EQ(dacpo_sheet_patches(nullptr,
+                                nullptr,
+                                1,
+                                nullptr,
+                                kK,
+                                kH,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                nullptr,
+                                &err),
             DACPO_ERR_INVALID_ARGUMENT);
 }
