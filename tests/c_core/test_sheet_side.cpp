@@ -107,6 +107,15 @@ runCue(const Cloud& c, std::vector<int8_t>* face_out, std::vector<int32_t>* nb_o
   return side;
 }
 
+// A side s (> 0: the face looks along +axis) names point i's true face.
+bool
+looksRight(const Cloud& c, size_t i, double s)
+{
+  const double* a = &c.axis[3 * i];
+  const double* o = &c.out[3 * i];
+  return (s > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
+}
+
 // Face labels of point i's row: how many, and how many name the right face.
 void
 countFaceLabels(const Cloud& c,
@@ -177,10 +186,7 @@ TEST(DacpoSheetSide, BoardThinnerThanTheSpacing)
     if (side[i] == 0.0)
       continue;
     ++fired;
-    // side > 0: the face looks along +axis
-    const double* a = &c.axis[3 * i];
-    const double* o = &c.out[3 * i];
-    right += (side[i] > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
+    right += looksRight(c, i, side[i]);
     countFaceLabels(c, face, nb, i, &labels, &labels_right);
   }
   printf("board 0.5 h: cue fires on %.2f %% of the points, right on %.2f %%; "
@@ -450,9 +456,7 @@ TEST(DacpoSheetSide, PatchesFindANoisyBoard)
     if (conf[i] == 0.0)
       continue;
     ++patch_fired;
-    const double* a = &c.axis[3 * i];
-    const double* o = &c.out[3 * i];
-    side_right += (conf[i] > 0.0) == (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] > 0.0);
+    side_right += looksRight(c, i, conf[i]);
     countFaceLabels(c, face, nb, i, &labels, &labels_right);
   }
   printf("noisy 0.9 h board: point test fires on %.2f %%, patches on %.2f %% of the "
