@@ -80,4 +80,17 @@ dacpo_view_rng_seed(dacpo_rng* rng);
 void
 dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3]);
 
+/* Parts that wrap around their own centroid (closed objects): outward[c] = +1
+ * if their normals (nrm, as they will be returned) face outward, -1 if inward,
+ * 0 for every other part. Failures: NULL argument (INVALID_ARGUMENT),
+ * OUT_OF_MEMORY. */
+dacpo_status
+dacpo_part_closed_outward(const double* xyz,
+                          const double* nrm,
+                          size_t n,
+                          const int32_t* part,
+                          size_t num_parts,
+                          int8_t* outward,
+                          dacpo_err* err);
+
 #endif

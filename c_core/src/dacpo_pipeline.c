@@ -623,6 +623,35 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
   return r;
 }
 
+/* A part other than the largest that wraps around its own centroid is a
+ * closed object seen from all round, which the viewpoint vote relates by a
+ * coin toss: after stage 6 it takes the sign under which it faces outward
+ * (dacpo_part_closed_outward). The side cue, where it speaks, still has the
+ * last word (parts_follow_the_cue runs after). */
+static dacpo_status
+closed_parts_outward(run_state* s, size_t np, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  double* now = current_normals(s);
+  int8_t* outward = dacpo_malloc_array(np, sizeof(int8_t));
+  size_t* size = dacpo_calloc_array(np, sizeof(size_t));
+  dacpo_status r = now && outward && size ? DACPO_OK : DACPO_OOM(err);
+  for (size_t i = 0; r == DACPO_OK && i < 3 * n; ++i)
+    now[i] *= s->global_sign;
+  if (r == DACPO_OK)
+    r = dacpo_part_closed_outward(s->cloud.xyz, now, n, s->part, np, outward, err);
+  if (r == DACPO_OK) {
+    const size_t big = dacpo_part_largest(s->part, n, np, size);
+    for (size_t q = 0; q < np; ++q)
+      if (q != big && outward[q] < 0)
+        s->part_sign[q] = (int8_t)-s->part_sign[q];
+  }
+  free(now);
+  free(outward);
+  free(size);
+  return r;
+}
+
 /* ---- stage 6: global sign ----------------------------------------------- */
 
 static dacpo_status
@@ -1157,6 +1186,8 @@ job_solve(dacpo_job* job, dacpo_err* err)
       (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))
     DACPO_TRY(relate_parts(s, st, err));
   DACPO_TRY(choose_global_sign(s, st, err));
+  if (s->part_sign)
+    DACPO_TRY(closed_parts_outward(s, st->num_parts, err));
   if (s->part_sign)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   return stage_done(job, DACPO_STAGE_ILP, err);

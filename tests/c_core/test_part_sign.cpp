@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,93 @@ TEST(PartSign, RoomPartsTakeOneRelationWhateverSignsTheyCameWith)
 TEST(PartSign, TwoRoomPartsTakeOneRelationWhateverSignsTheyCameWith)
 {
   expectOneRelation(DACPO_SCENE_TWO_ROOMS, 20000, 1.5);
+}
+
+// ---- closed parts face outward --------------------------------------------
+
+// Points of four parts with their true normals: 0 a sphere (outward), 1 its
+// upper half alone (a cap seen from one side), 2 an open tube with both walls
+// (outer wall facing out, inner wall facing the axis), 3 a flat square.
+struct Shapes {
+  std::vector<double> xyz, nrm;
+  std::vector<int32_t> part;
+  void
+  add(double x, double y, double z, double nx, double ny, double nz, int32_t q)
+  {
+    xyz.insert(xyz.end(), {x, y, z});
+    nrm.insert(nrm.end(), {nx, ny, nz});
+    part.push_back(q);
+  }
+};
+
+Shapes
+closedAndOpenShapes()
+{
+  Shapes s;
+  const double golden = 2.399963229728653; // Fibonacci sphere: even spread
+  const int m = 1500;
+  for (int32_t q = 0; q < 2; ++q) // the sphere's points first, then the cap's
+    for (int k = 0; k < m; ++k) {
+      const double z = 1.0 - 2.0 * (k + 0.5) / m, r = std::sqrt(1.0 - z * z);
+      const double x = r * std::cos(golden * k), y = r * std::sin(golden * k);
+      if (q == 0 || z > 0.0)
+        s.add(5.0 * q + 0.3 * x, 0.3 * y, 0.3 * z, x, y, z, q);
+    }
+  for (int k = 0; k < 40; ++k)
+    for (int h = 0; h < 20; ++h) {
+      const double a = 6.283185307179586 * k / 40, c = std::cos(a), d = std::sin(a);
+      const double z = 0.02 * h;
+      s.add(10.0 + 0.22 * c, 0.22 * d, z, c, d, 0.0, 2);
+      s.add(10.0 + 0.2 * c, 0.2 * d, z, -c, -d, 0.0, 2);
+    }
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j)
+      s.add(15.0 + 0.02 * i, 0.02 * j, 0.0, 0.0, 0.0, 1.0, 3);
+  return s;
+}
+
+TEST(PartSign, ClosedPartsAreToldFromOpenOnesAndSayWhichWayIsOut)
+{
+  Shapes s = closedAndOpenShapes();
+  const size_t n = s.part.size();
+  int8_t outward[4];
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 4, outward, &err),
+            DACPO_OK)
+      << err.msg;
+  EXPECT_EQ(outward[0], 1) << "sphere, outward normals";
+  EXPECT_EQ(outward[1], 0) << "a cap does not wrap around its centroid";
+  EXPECT_EQ(outward[2], 0) << "a tube's two walls face both ways";
+  EXPECT_EQ(outward[3], 0) << "flat";
+  // the same sphere inside out
+  for (size_t i = 0; i < n; ++i)
+    if (s.part[i] == 0)
+      for (int d = 0; d < 3; ++d)
+        s.nrm[3 * i + d] = -s.nrm[3 * i + d];
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 4, outward, &err),
+            DACPO_OK);
+  EXPECT_EQ(outward[0], -1) << "sphere, inward normals";
+  EXPECT_EQ(outward[1], 0);
+  // the inward sphere as the whole cloud: a closed room seen from inside
+  size_t m = 0;
+  while (m < n && s.part[m] == 0)
+    ++m;
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), m, s.part.data(), 1, outward, &err),
+            DACPO_OK);
+  EXPECT_EQ(outward[0], 0) << "a part as large as the scene is not an object";
+}
+
+TEST(PartSign, ClosedPartsRefuseNullInput)
+{
+  int8_t outward[2] = {5, 5};
+  dacpo_err err = {DACPO_OK, {0}};
+  EXPECT_EQ(dacpo_part_closed_outward(nullptr, nullptr, 0, nullptr, 0, nullptr, &err),
+            DACPO_OK);
+  EXPECT_EQ(dacpo_part_closed_outward(nullptr, nullptr, 3, nullptr, 2, outward, &err),
+            DACPO_ERR_INVALID_ARGUMENT);
 }
 
 } // namespace
