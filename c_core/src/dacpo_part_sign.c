@@ -268,7 +268,7 @@ dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, doubl
  * Why: the viewpoint vote relates a part to the scene by which way most of its
  * points face one viewpoint. An object seen from all round (a plant's crown
  * standing free in a room scanned from several places) faces every viewpoint
- * with half its points: the vote is a coin toss (room3001: a 642-point crown
+ * with half its points: the vote cannot place it (room3001: a 642-point crown
  * came out inside out on every seed, 0.6 % of the room). Such a part wraps
  * around its own centroid, and a closed surface's normals face outward, the
  * convention the global sign keeps for an enclosed scene: sign = that of the
