@@ -307,6 +307,47 @@ dacpo_edge_evidence_scale(const dacpo_block_graph* g)
 }
 
 dacpo_status
+dacpo_block_graph_blend(dacpo_block_graph* g,
+                        const dacpo_block_graph* other,
+                        double weight,
+                        dacpo_err* err)
+{
+  DACPO_CHECK(
+      err, g && other, DACPO_ERR_INVALID_ARGUMENT, "blend: NULL block graph");
+  DACPO_CHECK(err,
+              isfinite(weight) && weight >= 0.0,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "blend: weight must be finite and >= 0 (got %g)",
+              weight);
+  DACPO_CHECK(err,
+              g->num_edges == other->num_edges,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "blend: %zu edges against %zu",
+              g->num_edges,
+              other->num_edges);
+  for (size_t e = 0; e < g->num_edges; ++e)
+    DACPO_CHECK(err,
+                g->edges[e].a == other->edges[e].a && g->edges[e].b == other->edges[e].b,
+                DACPO_ERR_INVALID_ARGUMENT,
+                "blend: edge %zu joins blocks %d-%d in one graph, %d-%d in the other",
+                e,
+                (int)g->edges[e].a,
+                (int)g->edges[e].b,
+                (int)other->edges[e].a,
+                (int)other->edges[e].b);
+  const double sg = dacpo_edge_evidence_scale(g);
+  const double so = dacpo_edge_evidence_scale(other);
+  const double fg = sg > 0.0 ? 1.0 / sg : 0.0;
+  const double fo = so > 0.0 ? weight / so : 0.0;
+  for (size_t e = 0; e < g->num_edges; ++e) {
+    dacpo_block_edge* be = &g->edges[e];
+    be->alpha = fg * be->alpha + fo * other->edges[e].alpha;
+    be->alpha_bar = fg * be->alpha_bar + fo * other->edges[e].alpha_bar;
+  }
+  return DACPO_OK;
+}
+
+dacpo_status
 dacpo_block_graph_overlap_weights(dacpo_block_graph* g,
                                   const dacpo_blocks* blocks,
                                   const double* own_nrm,

@@ -72,4 +72,16 @@ dacpo_edge_omega(
 double
 dacpo_edge_evidence_scale(const dacpo_block_graph* g);
 
+/* Two measures of the same edges as one: g's evidence becomes
+ *   alpha = alpha_g / s_g + weight x alpha_o / s_o   (alpha_bar alike),
+ * s the measure's typical edge evidence (dacpo_edge_evidence_scale), so each
+ * counts in units of its own typical edge. A measure without evidence (s = 0)
+ * adds nothing. other must list the same edges in the same order
+ * (INVALID_ARGUMENT otherwise); weight must be finite and >= 0. */
+dacpo_status
+dacpo_block_graph_blend(dacpo_block_graph* g,
+                        const dacpo_block_graph* other,
+                        double weight,
+                        dacpo_err* err);
+
 #endif

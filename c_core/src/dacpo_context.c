@@ -100,6 +100,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_layers = -1.0;
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
+  p->seam_dipole = 0.0;
   p->dipole_c_thin = 4.0;
   p->normal_weight = 0.0;
   p->adaptive_normals = 1;
@@ -266,6 +267,9 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
   if (!(p->cue_anchor >= 0.0) || !isfinite(p->cue_anchor))
     return bad_field(
         message, size, "cue_anchor must be finite and >= 0 (got %g)", p->cue_anchor);
+  if (!(p->seam_dipole >= 0.0) || !isfinite(p->seam_dipole))
+    return bad_field(
+        message, size, "seam_dipole must be finite and >= 0 (got %g)", p->seam_dipole);
   return DACPO_OK;
 }
 

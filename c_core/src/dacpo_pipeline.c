@@ -1165,6 +1165,31 @@ dacpo_job_weigh_edges(dacpo_job* job)
   return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
 }
 
+/* Stage 4, second measure: with VCR weights, the dipole energy across each
+ * block seam (dacpo_block_graph_dipole_weights, Eq. 2 over the k-NN pairs that
+ * join the two blocks) is added, each measure in units of its typical edge
+ * (dacpo_block_graph_blend). The two fail on different edges: VCR needs a
+ * depth-continuous contact in the rendered views, which a narrow face of a
+ * noisy board (a strip one block wide) or a block joined by a few pairs lacks;
+ * the seam energy needs pairs that are not stacked across a thin part. */
+static dacpo_status
+add_seam_dipole(run_state* s, dacpo_err* err)
+{
+  const size_t ne = s->bgraph.num_edges;
+  if (s->p.edge_weight != DACPO_WEIGHT_VCR || !(s->p.seam_dipole > 0.0) || ne == 0)
+    return DACPO_OK;
+  dacpo_block_graph seam = {ne, dacpo_malloc_array(ne, sizeof(dacpo_block_edge))};
+  if (!seam.edges)
+    return DACPO_OOM(err);
+  memcpy(seam.edges, s->bgraph.edges, ne * sizeof(dacpo_block_edge));
+  dacpo_status st = dacpo_block_graph_dipole_weights(
+      &seam, &s->cloud, &s->adj, &s->blocks, s->oriented, s->p.dipole_c, err);
+  if (st == DACPO_OK)
+    st = dacpo_block_graph_blend(&s->bgraph, &seam, s->p.seam_dipole, err);
+  free(seam.edges);
+  return st;
+}
+
 /* Stages 5-6 and the parts. */
 static dacpo_status
 job_solve(dacpo_job* job, dacpo_err* err)
@@ -1181,6 +1206,7 @@ job_solve(dacpo_job* job, dacpo_err* err)
     if (s->ipsr[b].iterations > st->ipsr_iterations_max)
       st->ipsr_iterations_max = s->ipsr[b].iterations;
   }
+  DACPO_TRY(add_seam_dipole(s, err));
   DACPO_TRY(solve_flips(s, st, err));
   if (s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT &&
       (s->num_components > 1 || s->p.weak_edge_fraction > 0.0))

@@ -293,6 +293,53 @@ TEST(DacpoBlockGraph, EvidenceScaleIsTheMedianOfEdgesWithEvidence)
   EXPECT_EQ(dacpo_edge_evidence_scale(&g), 0.0);
 }
 
+// Two measures as one: each in units of its own typical (median) edge, the
+// second times the weight. VCR evidence {2, 4, 2} (median 2) and seam energy
+// {10, 10, 30} (median 10) at weight 0.5.
+TEST(DacpoBlockGraph, BlendAddsTwoMeasuresInUnitsOfTheirTypicalEdge)
+{
+  dacpo_block_edge v[3] = {{0, 1, 1, 2.0, 0.0}, {0, 2, 1, 1.0, 1.0}, {1, 2, 1, 0.0, 4.0}};
+  dacpo_block_edge d[3] = {{0, 1, 1, 0.0, 10.0}, {0, 2, 1, 0.0, 30.0}, {1, 2, 1, 10.0, 0.0}};
+  dacpo_block_graph g = {3, v}, o = {3, d};
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_block_graph_blend(&g, &o, 0.5, &err), DACPO_OK) << err.msg;
+  const double want[3][2] = {{1.0, 0.5}, {0.5, 2.0}, {0.5, 2.0}};
+  for (int e = 0; e < 3; ++e) {
+    EXPECT_DOUBLE_EQ(v[e].alpha, want[e][0]) << e;
+    EXPECT_DOUBLE_EQ(v[e].alpha_bar, want[e][1]) << e;
+  }
+}
+
+TEST(DacpoBlockGraph, BlendWithoutEvidenceOrWeightKeepsTheFirstMeasure)
+{
+  dacpo_block_edge v[2] = {{0, 1, 1, 3.0, 1.0}, {1, 2, 1, 0.0, 2.0}};
+  dacpo_block_edge z[2] = {{0, 1, 1, 0.0, 0.0}, {1, 2, 1, 0.0, 0.0}};
+  dacpo_block_graph g = {2, v}, o = {2, z};
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_block_graph_blend(&g, &o, 1.0, &err), DACPO_OK) << err.msg;
+  EXPECT_DOUBLE_EQ(v[0].alpha, 1.0); // median of {4, 2} = 3
+  EXPECT_DOUBLE_EQ(v[0].alpha_bar, 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(v[1].alpha_bar, 2.0 / 3.0);
+  z[0].alpha = 5.0;
+  ASSERT_EQ(dacpo_block_graph_blend(&g, &o, 0.0, &err), DACPO_OK) << err.msg;
+  EXPECT_DOUBLE_EQ(v[0].alpha, 1.0); // already in its own units (median 1): as it was
+}
+
+TEST(DacpoBlockGraph, BlendRefusesOtherEdgesAndBadWeights)
+{
+  dacpo_block_edge v[2] = {{0, 1, 1, 1.0, 0.0}, {1, 2, 1, 0.0, 1.0}};
+  dacpo_block_edge w[2] = {{0, 1, 1, 1.0, 0.0}, {1, 3, 1, 0.0, 1.0}};
+  dacpo_block_graph g = {2, v}, o = {2, w}, one = {1, w};
+  dacpo_err err = {DACPO_OK, {0}};
+  EXPECT_EQ(dacpo_block_graph_blend(&g, &o, 1.0, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(err.msg).find("edge 1"), std::string::npos) << err.msg;
+  EXPECT_EQ(dacpo_block_graph_blend(&g, &one, 1.0, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_blend(&g, &g, -1.0, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_blend(&g, &g, NAN, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(dacpo_block_graph_blend(nullptr, &g, 1.0, &err), DACPO_ERR_INVALID_ARGUMENT);
+  EXPECT_DOUBLE_EQ(v[0].alpha, 1.0); // untouched by the refused calls
+}
+
 TEST(DacpoBlockGraph, SingleBlockAndEmptyInputHaveNoEdges)
 {
   const int32_t one[4] = {0, 0, 0, 0};

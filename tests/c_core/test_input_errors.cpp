@@ -593,6 +593,8 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
       {"adaptive_normals", [](dacpo_params* p) { p->adaptive_normals = 2; }},
       {"dipole_c_thin", [](dacpo_params* p) { p->dipole_c_thin = NAN; }},
       {"cue_anchor", [](dacpo_params* p) { p->cue_anchor = INFINITY; }},
+      {"seam_dipole", [](dacpo_params* p) { p->seam_dipole = -0.5; }},
+      {"seam_dipole", [](dacpo_params* p) { p->seam_dipole = NAN; }},
       {"k", [](dacpo_params* p) { p->k = 100000; }},
   };
   auto ctx = makeCtx();

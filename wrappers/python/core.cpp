@@ -52,6 +52,7 @@ defaultParams()
   d["dipole_layers"] = p.dipole_layers;
   d["dipole_sides"] = p.dipole_sides;
   d["cue_anchor"] = p.cue_anchor;
+  d["seam_dipole"] = p.seam_dipole;
   d["dipole_c_thin"] = p.dipole_c_thin;
   d["normal_weight"] = p.normal_weight;
   d["adaptive_normals"] = p.adaptive_normals != 0;
@@ -102,6 +103,7 @@ toParams(const py::dict& d)
   p.dipole_layers = get<double>(d, "dipole_layers", p.dipole_layers);
   p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
   p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
+  p.seam_dipole = get<double>(d, "seam_dipole", p.seam_dipole);
   p.dipole_c_thin = get<double>(d, "dipole_c_thin", p.dipole_c_thin);
   p.normal_weight = get<double>(d, "normal_weight", p.normal_weight);
   p.adaptive_normals =

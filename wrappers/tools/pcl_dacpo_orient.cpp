@@ -371,6 +371,13 @@ const OptionSpec kOptions[] = {
      "sign the cue gives it in the 0-1 program, 0 = off",
      showNumber<double, &dacpo_params::cue_anchor>,
      setDouble<&dacpo_params::cue_anchor>},
+    {"-seam_dipole",
+     "X",
+     "VCR block edges: add the dipole energy across the block\n"
+     "seam as a second measure with this weight (each in units\n"
+     "of its typical edge), 0 = VCR alone",
+     showNumber<double, &dacpo_params::seam_dipole>,
+     setDouble<&dacpo_params::seam_dipole>},
     {"-orders",
      "X",
      "randomized dipole propagation orders",

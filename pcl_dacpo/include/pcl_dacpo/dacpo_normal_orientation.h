@@ -696,6 +696,22 @@ public:
     return params_.cue_anchor;
   }
 
+  /** \brief With EdgeWeight::VCR: the dipole energy across each block seam
+   * is added to the VCR evidence as a second measure with this weight (each
+   * in units of its typical edge); 0 = VCR alone (default). See
+   * dacpo_params.seam_dipole. */
+  void
+  setSeamDipole(double weight)
+  {
+    params_.seam_dipole = weight;
+  }
+  /** \brief See setSeamDipole(). */
+  double
+  getSeamDipole() const
+  {
+    return params_.seam_dipole;
+  }
+
   /**
    * \brief Set every core parameter at once. params.k replaces setKSearch();
    * params.estimate_normals is ignored (decided by setInputNormals()).
