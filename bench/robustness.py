@@ -31,7 +31,7 @@ def parse():
     ap.add_argument("--label", default="default", help="name of this configuration")
     ap.add_argument("--args", default="", help="extra pcl_dacpo_orient arguments")
     ap.add_argument("--block-factor", type=float, default=None,
-                    help="run with -blocks = factor x the automatic count (n/1250 in [1, 200]): "
+                    help="run with -blocks = factor x the automatic count (n/625 in [1, 400]): "
                          "sensitivity to the block count")
     ap.add_argument("--peer", default=None,
                     help="score a peer program instead (called as PEER in.ply out.ply ARGS, "
@@ -84,7 +84,7 @@ def run_one(opt, f, seed):
         cmd = [os.path.join(tools, "pcl_dacpo_orient"), f, pred, "-estimate", "-labels",
                "-seed", str(seed), "-threads", "1"] + opt.args.split()
         if opt.block_factor:
-            auto = min(200, max(1, ply_vertices(f) // 1250))
+            auto = min(400, max(1, ply_vertices(f) // 625))
             cmd += ["-blocks", str(max(1, round(auto * opt.block_factor)))]
     t0 = time.perf_counter()
     r = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True)

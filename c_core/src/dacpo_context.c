@@ -88,7 +88,7 @@ dacpo_params_init(dacpo_params* p)
   p->disconnected = DACPO_DISCONNECTED_VIEWPOINT;
   p->dipole_noise_band = 0.0;
   p->keep_mesh = 0;
-  p->vcr_image_size = 400;
+  p->vcr_image_size = 200;
   p->vcr_views = 12;
   p->vcr_perspective = 0;
   p->vcr_boundary_factor = 1;
@@ -100,7 +100,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_layers = -1.0;
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
-  p->seam_dipole = 0.0;
+  p->seam_dipole = 0.5;
   p->dipole_c_thin = 4.0;
   p->normal_weight = 0.0;
   p->adaptive_normals = 1;

@@ -535,15 +535,25 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
  * sign (free space decides the scene's sign). Measured on room3004 (σ 0.008,
  * seed 5): cue points right on 97 % of 2,258, yet two weakly joined blocks
  * holding 1,728 of them came out wrong when only stage 5 used the cue (the
- * vote and stage 6 related their part the other way): 9.51 -> 11.68 %. */
+ * vote and stage 6 related their part the other way): 9.51 -> 11.68 %.
+ * Where the largest part's own cue points clearly disagree with the sign it
+ * got (more than DACPO_CUE_REFERENCE_MARGIN of their weight net against:
+ * a scene with no free space to tell, such as two sheets facing away, split
+ * into one part per sheet by weak block edges), the others follow the cue
+ * the way the largest part does, so the parts stay consistent with each
+ * other (two sheets one spacing apart, blocks of 625 points: 49.7 -> 0 %). */
+#define DACPO_CUE_REFERENCE_MARGIN 0.5
+
 static dacpo_status
 parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
 {
   const size_t nb = s->blocks.num_blocks, n = s->cloud.n;
   double* vote = dacpo_calloc_array(np, sizeof(double));
+  double* weight = dacpo_calloc_array(np, sizeof(double));
   size_t* size = dacpo_calloc_array(np, sizeof(size_t));
-  if (!vote || !size) {
+  if (!vote || !weight || !size) {
     free(vote);
+    free(weight);
     free(size);
     return DACPO_OOM(err);
   }
@@ -554,14 +564,19 @@ parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
       continue;
     const size_t q = (size_t)s->part[s->blocks.own[s->blocks.own_start[b]]];
     vote[q] += (double)says * (s->flips[b] ? -1.0 : 1.0) * points;
+    weight[q] += points;
   }
   const size_t big = dacpo_part_largest(s->part, n, np, size);
+  const double big_agrees = (double)s->part_sign[big] * s->global_sign * vote[big];
+  const double reference =
+      big_agrees < -DACPO_CUE_REFERENCE_MARGIN * weight[big] ? -1.0 : 1.0;
   for (size_t q = 0; q < np; ++q)
-    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] < 0.0) {
+    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] * reference < 0.0) {
       s->part_sign[q] = (int8_t)-s->part_sign[q];
       ++*turned;
     }
   free(vote);
+  free(weight);
   free(size);
   return DACPO_OK;
 }
@@ -831,18 +846,20 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 static size_t
 auto_blocks(size_t n)
 {
-  /* about 1,250 points per block, at most the paper's 200. Halving the block
-   * size (from 2,500) moves decisions a block got wrong inside (a thin part
-   * turned over with the floor around it) to the block graph: seeds 1-5,
-   * frames 3.02 -> 2.35 % (worst 3.86 -> 2.55, largest seed spread 5.13 ->
-   * 2.88), rooms 6.50 -> 6.22 % (worst 7.15 -> 6.58, spread 3.15 -> 1.54);
-   * a quarter (625) gave frames 2.06 % but rooms worse on the worst seed (6.88)
-   * and more block flips (see docs/DESIGN.md). */
-  size_t b = n / 1250;
+  /* about 625 points per block, at most 400 (the paper: 200). Small blocks
+   * move decisions a block got wrong inside (a chair inside out on the floor
+   * block it stands on) to the block graph; they need the seam dipole energy
+   * beside VCR (seam_dipole), or a noisy board's narrow face, a block of its
+   * own with a few pixels of VCR evidence, gets flipped. Seeds 1-5, against
+   * 1,250 points (cap 200) with VCR alone: frames 1.60 -> 1.51 % (worst 1.78
+   * -> 1.74), rooms 4.70 -> 4.39 % (worst 5.01 -> 4.99). 400 blocks fit the
+   * time budget with VCR images of 200 px (500K room 28.6 s; see
+   * docs/DESIGN.md). */
+  size_t b = n / 625;
   if (b < 1)
     b = 1;
-  if (b > 200)
-    b = 200;
+  if (b > 400)
+    b = 400;
   return b;
 }
 /* Stage 1: blocks, overlap rings and the block graph. */

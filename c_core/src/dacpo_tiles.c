@@ -42,10 +42,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Automatic halo in spacings of the full cloud: about half a block's width
- * (a 1,250-point block is ~35 spacings across), so that the evidence between
- * two tiles rests on whole blocks seen from both, and the k-NN rows and
- * normals of points near a cut are those of the whole cloud. */
+/* Automatic halo in spacings of the full cloud: half a block's width or more
+ * (a 1,250-point block is ~35 spacings across, a 625-point one ~25), so that
+ * the evidence between two tiles rests on whole blocks seen from both, and
+ * the k-NN rows and normals of points near a cut are those of the whole
+ * cloud. */
 #define DACPO_TILE_HALO_SPACINGS 16.0
 /* The split aims at this share of max_points for the own points, leaving
  * room for the halo. */

@@ -507,8 +507,8 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   d.setDisconnectedPolicy(Orientation::DisconnectedPolicy::Bridge);
   EXPECT_EQ(d.getCueAnchor(), 1.0); // the default
   d.setCueAnchor(0.25);
-  EXPECT_EQ(d.getSeamDipole(), 0.0);
-  d.setSeamDipole(0.5);
+  EXPECT_EQ(d.getSeamDipole(), 0.5);
+  d.setSeamDipole(0.25);
   d.setAdaptiveNormals(true);
   EXPECT_TRUE(d.getAdaptiveNormals());
   EXPECT_EQ(d.getNormalK(), 12u);
@@ -530,7 +530,7 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_EQ(p.estimate_normals, 1);
   EXPECT_EQ(p.num_blocks, 7u);
   EXPECT_EQ(p.cue_anchor, 0.25);
-  EXPECT_EQ(p.seam_dipole, 0.5);
+  EXPECT_EQ(p.seam_dipole, 0.25);
   EXPECT_EQ(p.adaptive_normals, 1);
   d.setNumberOfThreads();
   EXPECT_EQ(d.getNumberOfThreads(), 0u);

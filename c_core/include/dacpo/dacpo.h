@@ -152,7 +152,7 @@ typedef struct dacpo_params {
   int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
                              0: use the given normals as axes (default 0) */
   size_t num_blocks;    /**< target number of blocks; 0 = automatic:
-                             n/1250 clamped to [1, 200] (default 0) */
+                             n/625 clamped to [1, 400] (default 0) */
   size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
   double dipole_c;      /**< c of paper Eq. 1 (-1: by the scan kind, 1 for a single
                              depth view, 1.5 otherwise; values >= 1). The paper
@@ -189,7 +189,11 @@ typedef struct dacpo_params {
                                  with noise 0.008 from 46 % to 10 %. */
   int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
                                  wound to agree with them; see dacpo_ctx_mesh() (0) */
-  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (400, paper) */
+  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (200; the
+                                 paper: 400 for its 200 blocks. With 400 blocks of
+                                 625 points, seeds 1-5, 400 -> 200 px: rooms 4.41
+                                 -> 4.39 %, frames 1.50 -> 1.51 %; 500K room
+                                 edge weights 12.8 -> 4.5 s) */
   size_t vcr_views;         /**< VCR views: 12 = dodecahedron face centres (paper);
                                  other counts use a Fibonacci sphere, [1, 256] (12) */
   int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
@@ -309,7 +313,7 @@ typedef struct dacpo_params {
                                       typical edge's, VCR over its own. With
                                       blocks of 625 points, seeds 1-5, 15 frames /
                                       18 rooms: VCR alone 1.57 / 4.53 %, 0.5 1.50
-                                      / 4.41 % (README). 0 = VCR alone (0) */
+                                      / 4.41 % (README). 0 = VCR alone (0.5) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

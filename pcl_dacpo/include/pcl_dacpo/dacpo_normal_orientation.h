@@ -234,7 +234,7 @@ public:
     return params_.adaptive_normals != 0;
   }
 
-  /** \brief Target number of blocks; 0 = automatic, n/1250 in [1, 200] (default 0). */
+  /** \brief Target number of blocks; 0 = automatic, n/625 in [1, 400] (default 0). */
   void
   setNumberOfBlocks(std::size_t num_blocks)
   {
@@ -507,7 +507,7 @@ public:
     return static_cast<DisconnectedPolicy>(params_.disconnected);
   }
 
-  /** \brief VCR image side in pixels (default 400, as in the paper). */
+  /** \brief VCR image side in pixels (default 200; the paper: 400 for 200 blocks). */
   void
   setVCRImageSize(std::size_t pixels)
   {
@@ -698,7 +698,7 @@ public:
 
   /** \brief With EdgeWeight::VCR: the dipole energy across each block seam
    * is added to the VCR evidence as a second measure with this weight (each
-   * in units of its typical edge); 0 = VCR alone (default). See
+   * in units of its typical edge; default 0.5); 0 = VCR alone. See
    * dacpo_params.seam_dipole. */
   void
   setSeamDipole(double weight)
