@@ -571,7 +571,8 @@ parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
   const double reference =
       big_agrees < -DACPO_CUE_REFERENCE_MARGIN * weight[big] ? -1.0 : 1.0;
   for (size_t q = 0; q < np; ++q)
-    if (q != big && (double)s->part_sign[q] * s->global_sign * vote[q] * reference < 0.0) {
+    if (q != big &&
+        (double)s->part_sign[q] * s->global_sign * vote[q] * reference < 0.0) {
       s->part_sign[q] = (int8_t)-s->part_sign[q];
       ++*turned;
     }
