@@ -101,6 +101,7 @@ dacpo_params_init(dacpo_params* p)
   p->dipole_sides = 0.001;
   p->cue_anchor = 1.0;
   p->seam_dipole = 0.5;
+  p->surface_vote = 500;
   p->dipole_c_thin = 4.0;
   p->normal_weight = 0.0;
   p->adaptive_normals = 1;

@@ -26,6 +26,7 @@
 #include "dacpo_part_sign.h"
 #include "dacpo_scene_mesh.h"
 #include "dacpo_segment.h"
+#include "dacpo_surface_vote.h"
 #include "dacpo_vcr.h"
 #include "dacpo_view_kind.h"
 
@@ -771,6 +772,56 @@ part_confidence(const run_state* s, size_t i)
   return s->input_component[i] == s->largest_component_id ? 1.0 : 0.0;
 }
 
+/* After stages 5-6: large smooth surfaces keep one orientation
+ * (dacpo_surface_vote.c, surface_vote = the smallest surface that votes, 0 =
+ * off). *turned_out (NULL when off) marks the distinct points it turned over
+ * against their block's, part's and the global sign. */
+static dacpo_status
+surface_vote(run_state* s, dacpo_stats* st, uint8_t** turned_out, dacpo_err* err)
+{
+  const dacpo_cloud* c = &s->cloud;
+  *turned_out = NULL;
+  st->surface_vote_turned = 0;
+  if (s->p.surface_vote == 0 || c->n == 0)
+    return DACPO_OK;
+  int8_t* sign = dacpo_malloc_array(c->n, sizeof(int8_t));
+  uint8_t* turned = dacpo_malloc_array(c->n, sizeof(uint8_t));
+  if (!sign || !turned) {
+    free(sign);
+    free(turned);
+    return DACPO_OOM(err);
+  }
+  /* the final sign of each point relative to its axis (c->nrm) */
+  for (size_t i = 0; i < c->n; ++i) {
+    const double* o = s->oriented + 3 * i;
+    const double* a = c->nrm + 3 * i;
+    double v = (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] >= 0.0 ? 1.0 : -1.0) *
+               (s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0) * s->global_sign;
+    if (s->part_sign)
+      v *= (double)s->part_sign[s->part[i]];
+    sign[i] = v > 0.0 ? 1 : -1;
+    turned[i] = (uint8_t)(sign[i] > 0);
+  }
+  const dacpo_status r = dacpo_surface_vote(c->xyz,
+                                            c->nrm,
+                                            &s->adj,
+                                            DACPO_SURFACE_VOTE_ANGLE,
+                                            s->p.surface_vote,
+                                            sign,
+                                            &st->surface_vote_turned,
+                                            NULL,
+                                            err);
+  for (size_t i = 0; i < c->n; ++i)
+    turned[i] = (uint8_t)(turned[i] != (uint8_t)(sign[i] > 0));
+  free(sign);
+  if (r != DACPO_OK) {
+    free(turned);
+    return r;
+  }
+  *turned_out = turned;
+  return DACPO_OK;
+}
+
 static dacpo_status
 publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 {
@@ -810,6 +861,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
   /* The output keeps each input point's own axis (given or PCA) and only takes
    * its sign from the refined, flipped block normal: orientation is what DACPO
    * decides, the axis is the caller's. */
+  uint8_t* turned = NULL;
+  DACPO_TRY(surface_vote(s, st, &turned, err));
   for (size_t j = 0; j < count; ++j) {
     const size_t i = (size_t)c->input_to_point[j];
     const double flip = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
@@ -829,6 +882,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip * s->global_sign;
     if (s->part_sign)
       sign *= (double)s->part_sign[s->part[i]];
+    if (turned && turned[i])
+      sign = -sign;
     for (int d = 0; d < 3; ++d)
       normals[3 * j + d] = (float)(sign * axis[d]);
     ctx->point_component[j] = s->input_component[i];
@@ -838,6 +893,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
+  free(turned);
   st->solver_optimal = s->ilp.optimal;
   st->solver_objective = s->ilp.objective;
   st->ilp_constraints = s->ilp.constraints;

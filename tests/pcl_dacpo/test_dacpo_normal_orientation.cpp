@@ -509,6 +509,8 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   d.setCueAnchor(0.25);
   EXPECT_EQ(d.getSeamDipole(), 0.5);
   d.setSeamDipole(0.25);
+  EXPECT_EQ(d.getSurfaceVote(), 500u);
+  d.setSurfaceVote(250);
   d.setAdaptiveNormals(true);
   EXPECT_TRUE(d.getAdaptiveNormals());
   EXPECT_EQ(d.getNormalK(), 12u);
@@ -531,6 +533,7 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_EQ(p.num_blocks, 7u);
   EXPECT_EQ(p.cue_anchor, 0.25);
   EXPECT_EQ(p.seam_dipole, 0.25);
+  EXPECT_EQ(p.surface_vote, 250u);
   EXPECT_EQ(p.adaptive_normals, 1);
   d.setNumberOfThreads();
   EXPECT_EQ(d.getNumberOfThreads(), 0u);

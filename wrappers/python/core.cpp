@@ -53,6 +53,7 @@ defaultParams()
   d["dipole_sides"] = p.dipole_sides;
   d["cue_anchor"] = p.cue_anchor;
   d["seam_dipole"] = p.seam_dipole;
+  d["surface_vote"] = p.surface_vote;
   d["dipole_c_thin"] = p.dipole_c_thin;
   d["normal_weight"] = p.normal_weight;
   d["adaptive_normals"] = p.adaptive_normals != 0;
@@ -104,6 +105,7 @@ toParams(const py::dict& d)
   p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
   p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
   p.seam_dipole = get<double>(d, "seam_dipole", p.seam_dipole);
+  p.surface_vote = get<size_t>(d, "surface_vote", p.surface_vote);
   p.dipole_c_thin = get<double>(d, "dipole_c_thin", p.dipole_c_thin);
   p.normal_weight = get<double>(d, "normal_weight", p.normal_weight);
   p.adaptive_normals =
@@ -215,6 +217,7 @@ statsDict(const dacpo_stats* s)
   stats["parts_related"] = s->parts_related;
   stats["cue_anchored_blocks"] = s->cue_anchored_blocks;
   stats["parts_cue_signed"] = s->parts_cue_signed;
+  stats["surface_vote_turned"] = s->surface_vote_turned;
   stats["view_score"] = s->view_score;
   stats["sign_flipped"] = s->sign_flipped != 0;
   stats["sign_facing"] = s->sign_facing;

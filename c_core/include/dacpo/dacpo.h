@@ -314,6 +314,15 @@ typedef struct dacpo_params {
                                       blocks of 625 points, seeds 1-5, 15 frames /
                                       18 rooms: VCR alone 1.57 / 4.53 %, 0.5 1.50
                                       / 4.41 % (README). 0 = VCR alone (0.5) */
+  size_t surface_vote;           /**< after the 0-1 program: on every smooth surface
+                                      of at least this many points (neighbours
+                                      with axes within 8 degrees of parallel, each
+                                      in the other's tangent plane), points
+                                      against the surface's majority are turned
+                                      over, unless they are over a fifth of it
+                                      (two faces of a thin part merged). Mends
+                                      blocks a junction left half or wholly
+                                      inside out. 0 = off (500) */
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */
@@ -405,6 +414,8 @@ typedef struct dacpo_stats {
                                    (dacpo_params.cue_anchor) */
   size_t parts_cue_signed;    /**< parts (not the largest) whose sign the cue
                                    turned after the viewpoint vote and stage 6 */
+  size_t surface_vote_turned; /**< distinct points the surface vote turned over
+                                   (dacpo_params.surface_vote) */
   dacpo_scan_kind scan_kind;  /**< the kind the run used (never AUTO) */
   double single_view_fit;     /**< AUTO: how well one sensor position explains the
                                    sampling density (correlation, -1..1; >= 0.5:

@@ -712,6 +712,23 @@ public:
     return params_.seam_dipole;
   }
 
+  /** \brief After the 0-1 program, every smooth surface of at least
+   * \a min_points points (neighbouring axes within 8 degrees, each neighbour
+   * in the other's tangent plane) turns over its points that face against
+   * its majority, unless they are over a fifth of it (default 500); 0 =
+   * off. See dacpo_params.surface_vote. */
+  void
+  setSurfaceVote(std::size_t min_points)
+  {
+    params_.surface_vote = min_points;
+  }
+  /** \brief See setSurfaceVote(). */
+  std::size_t
+  getSurfaceVote() const
+  {
+    return params_.surface_vote;
+  }
+
   /**
    * \brief Set every core parameter at once. params.k replaces setKSearch();
    * params.estimate_normals is ignored (decided by setInputNormals()).
