@@ -62,6 +62,7 @@ run_state_free(run_state* s)
   free(s->part);
   free(s->part_sign);
   free(s->part_conf);
+  free(s->turned);
   free(s->block_done);
   free(s->edge_done);
 }
@@ -701,10 +702,63 @@ choose_global_sign(run_state* s, dacpo_stats* st, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* The sign the run gives stage 3's normal of distinct point i: its block's
+ * flip, the global sign, its part's sign and the surface vote. */
+static double
+point_sign(const run_state* s, size_t i)
+{
+  double sign = (s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0) * s->global_sign;
+  if (s->part_sign)
+    sign *= (double)s->part_sign[s->part[i]];
+  if (s->turned && s->turned[i])
+    sign = -sign;
+  return sign;
+}
+
+/* After stages 5-6: large smooth surfaces keep one orientation
+ * (dacpo_surface_vote.c; surface_vote = the smallest surface that votes, 0 =
+ * off). s->turned marks the points it turned over against their block's,
+ * part's and the global sign. */
+static dacpo_status
+surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const dacpo_cloud* c = &s->cloud;
+  st->surface_vote_turned = 0;
+  if (s->p.surface_vote == 0 || c->n == 0)
+    return DACPO_OK;
+  int8_t* sign = dacpo_malloc_array(c->n, sizeof(int8_t));
+  int8_t* before = dacpo_malloc_array(c->n, sizeof(int8_t));
+  s->turned = dacpo_calloc_array(c->n, sizeof(uint8_t));
+  dacpo_status r = sign && before && s->turned ? DACPO_OK : DACPO_OOM(err);
+  /* the sign of each point relative to its axis (c->nrm) */
+  for (size_t i = 0; i < c->n && r == DACPO_OK; ++i) {
+    const double* o = s->oriented + 3 * i;
+    const double* a = c->nrm + 3 * i;
+    const double dot = a[0] * o[0] + a[1] * o[1] + a[2] * o[2];
+    sign[i] = before[i] = (dot >= 0.0 ? 1.0 : -1.0) * point_sign(s, i) > 0.0 ? 1 : -1;
+  }
+  if (r == DACPO_OK)
+    r = dacpo_surface_vote(c->xyz,
+                           c->nrm,
+                           &s->adj,
+                           DACPO_SURFACE_VOTE_ANGLE,
+                           s->p.surface_vote,
+                           sign,
+                           &st->surface_vote_turned,
+                           NULL,
+                           err);
+  for (size_t i = 0; i < c->n && r == DACPO_OK; ++i)
+    s->turned[i] = (uint8_t)(sign[i] != before[i]);
+  free(sign);
+  free(before);
+  return r;
+}
+
 /* ---- scene mesh ---------------------------------------------------------- */
 
 /* keep_mesh: one surface over all blocks from the normals as they will be
- * returned (block flips, part signs and the global sign applied). */
+ * returned (block flips, part signs, the global sign and the surface vote
+ * applied). */
 static dacpo_status
 build_scene_mesh(run_state* s, dacpo_err* err)
 {
@@ -715,9 +769,7 @@ build_scene_mesh(run_state* s, dacpo_err* err)
   if (!nrm || !spacing)
     status = DACPO_OOM(err);
   for (size_t i = 0; i < n && status == DACPO_OK; ++i) {
-    double sign = (s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0) * s->global_sign;
-    if (s->part_sign)
-      sign *= (double)s->part_sign[s->part[i]];
+    const double sign = point_sign(s, i);
     for (int d = 0; d < 3; ++d)
       nrm[3 * i + d] = sign * s->oriented[3 * i + d];
   }
@@ -772,56 +824,6 @@ part_confidence(const run_state* s, size_t i)
   return s->input_component[i] == s->largest_component_id ? 1.0 : 0.0;
 }
 
-/* After stages 5-6: large smooth surfaces keep one orientation
- * (dacpo_surface_vote.c, surface_vote = the smallest surface that votes, 0 =
- * off). *turned_out (NULL when off) marks the distinct points it turned over
- * against their block's, part's and the global sign. */
-static dacpo_status
-surface_vote(run_state* s, dacpo_stats* st, uint8_t** turned_out, dacpo_err* err)
-{
-  const dacpo_cloud* c = &s->cloud;
-  *turned_out = NULL;
-  st->surface_vote_turned = 0;
-  if (s->p.surface_vote == 0 || c->n == 0)
-    return DACPO_OK;
-  int8_t* sign = dacpo_malloc_array(c->n, sizeof(int8_t));
-  uint8_t* turned = dacpo_malloc_array(c->n, sizeof(uint8_t));
-  if (!sign || !turned) {
-    free(sign);
-    free(turned);
-    return DACPO_OOM(err);
-  }
-  /* the final sign of each point relative to its axis (c->nrm) */
-  for (size_t i = 0; i < c->n; ++i) {
-    const double* o = s->oriented + 3 * i;
-    const double* a = c->nrm + 3 * i;
-    double v = (a[0] * o[0] + a[1] * o[1] + a[2] * o[2] >= 0.0 ? 1.0 : -1.0) *
-               (s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0) * s->global_sign;
-    if (s->part_sign)
-      v *= (double)s->part_sign[s->part[i]];
-    sign[i] = v > 0.0 ? 1 : -1;
-    turned[i] = (uint8_t)(sign[i] > 0);
-  }
-  const dacpo_status r = dacpo_surface_vote(c->xyz,
-                                            c->nrm,
-                                            &s->adj,
-                                            DACPO_SURFACE_VOTE_ANGLE,
-                                            s->p.surface_vote,
-                                            sign,
-                                            &st->surface_vote_turned,
-                                            NULL,
-                                            err);
-  for (size_t i = 0; i < c->n; ++i)
-    turned[i] = (uint8_t)(turned[i] != (uint8_t)(sign[i] > 0));
-  free(sign);
-  if (r != DACPO_OK) {
-    free(turned);
-    return r;
-  }
-  *turned_out = turned;
-  return DACPO_OK;
-}
-
 static dacpo_status
 publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
 {
@@ -861,11 +863,8 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
   /* The output keeps each input point's own axis (given or PCA) and only takes
    * its sign from the refined, flipped block normal: orientation is what DACPO
    * decides, the axis is the caller's. */
-  uint8_t* turned = NULL;
-  DACPO_TRY(surface_vote(s, st, &turned, err));
   for (size_t j = 0; j < count; ++j) {
     const size_t i = (size_t)c->input_to_point[j];
-    const double flip = s->flips[s->blocks.block_of[i]] ? -1.0 : 1.0;
     const double* o = s->oriented + 3 * i;
     double axis[3];
     if (normals && !s->p.estimate_normals) {
@@ -879,11 +878,7 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
       memcpy(axis, c->nrm + 3 * i, sizeof(axis));
     }
     double dot = axis[0] * o[0] + axis[1] * o[1] + axis[2] * o[2];
-    double sign = (dot >= 0.0 ? 1.0 : -1.0) * flip * s->global_sign;
-    if (s->part_sign)
-      sign *= (double)s->part_sign[s->part[i]];
-    if (turned && turned[i])
-      sign = -sign;
+    const double sign = (dot >= 0.0 ? 1.0 : -1.0) * point_sign(s, i);
     for (int d = 0; d < 3; ++d)
       normals[3 * j + d] = (float)(sign * axis[d]);
     ctx->point_component[j] = s->input_component[i];
@@ -893,7 +888,6 @@ publish(dacpo_ctx* ctx, run_state* s, float* normals, dacpo_err* err)
     if (ctx->point_curvature)
       ctx->point_curvature[j] = s->curvature[i];
   }
-  free(turned);
   st->solver_optimal = s->ilp.optimal;
   st->solver_objective = s->ilp.objective;
   st->ilp_constraints = s->ilp.constraints;
@@ -1290,6 +1284,7 @@ job_solve(dacpo_job* job, dacpo_err* err)
     DACPO_TRY(closed_parts_outward(s, st->num_parts, err));
   if (s->part_sign)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
+  DACPO_TRY(surface_vote(s, st, err));
   return stage_done(job, DACPO_STAGE_ILP, err);
 }
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* After stage 5: large smooth surfaces keep one orientation. */
+/* After stages 5-6: large smooth surfaces keep one orientation. */
 #ifndef DACPO_SURFACE_VOTE_H
 #define DACPO_SURFACE_VOTE_H
 
