@@ -284,3 +284,43 @@ TEST(DacpoThinStructures, SheetsSplitIntoPartsStayFacingAway)
     EXPECT_LE(wrong, 0.5) << "seed " << seed;
   }
 }
+
+// Generated rooms (the `room` scene of dacpo_make_scene) in which a whole thin
+// object came out inside out on some run seeds although its side cue was right
+// (measured with the library defaults, % wrong):
+//  - scene seed 12, 100K points, sigma 4 mm, run seed 1: 11.28. The largest
+//    part's cue points disagreed with its sign by a net 52 % of them (a
+//    bookshelf against a wall, 3,347 of its 89,481 points), so every other
+//    part followed its cue the other way round and a table and a partition
+//    turned inside out. The largest part now sets that reference only where
+//    its cue points are at least a quarter of it (two sheets facing away):
+//    5.00.
+TEST(DacpoThinStructures, RoomThinObjectsFollowTheirCueAfterStage6)
+{
+  struct RoomCase {
+    uint64_t scene_seed;
+    size_t points;
+    double noise;
+    uint64_t run_seed;
+  };
+  const RoomCase cases[] = {{12, 100000, 0.004, 1}};
+  for (const RoomCase& c : cases) {
+    dacpo_scene_params sp;
+    dacpo_scene_params_init(&sp);
+    sp.kind = DACPO_SCENE_ROOM;
+    sp.target_points = c.points;
+    sp.noise_sigma = c.noise;
+    sp.seed = c.scene_seed;
+    dacpo_scene sc{};
+    char err[256];
+    ASSERT_EQ(dacpo_scene_generate(&sp, &sc, err, sizeof(err)), 0) << err;
+    const double wrong = orientAndScore(sc, 0.0, c.run_seed, 0.001);
+    printf("room (scene seed %llu, %zu points, sigma %.3f), run seed %llu: %.2f %% wrong\n",
+           static_cast<unsigned long long>(c.scene_seed),
+           c.points,
+           c.noise,
+           static_cast<unsigned long long>(c.run_seed),
+           wrong);
+    EXPECT_LE(wrong, 6.0) << "scene seed " << c.scene_seed;
+  }
+}
