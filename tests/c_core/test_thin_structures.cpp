@@ -295,6 +295,12 @@ TEST(DacpoThinStructures, SheetsSplitIntoPartsStayFacingAway)
 //    turned inside out. The largest part now sets that reference only where
 //    its cue points are at least a quarter of it (two sheets facing away):
 //    5.00.
+//  - scene seed 11, 60K points, sigma 8 mm, run seed 4: 7.05 with that rule.
+//    A table top in the largest part (three blocks, 923 cue points all against
+//    their final sign) was related to the floor under it the wrong way by a
+//    seam through a leg; stage 5 made it agree with its cue and the shell
+//    disagree, and stage 6 turned both. After stage 6 it now turns back where
+//    its anchors outweigh the edges that join it to the rest: 4.39.
 TEST(DacpoThinStructures, RoomThinObjectsFollowTheirCueAfterStage6)
 {
   struct RoomCase {
@@ -303,7 +309,7 @@ TEST(DacpoThinStructures, RoomThinObjectsFollowTheirCueAfterStage6)
     double noise;
     uint64_t run_seed;
   };
-  const RoomCase cases[] = {{12, 100000, 0.004, 1}};
+  const RoomCase cases[] = {{12, 100000, 0.004, 1}, {11, 60000, 0.008, 4}};
   for (const RoomCase& c : cases) {
     dacpo_scene_params sp;
     dacpo_scene_params_init(&sp);

@@ -416,6 +416,9 @@ typedef struct dacpo_stats {
                                    turned after the viewpoint vote and stage 6 */
   size_t surface_vote_turned; /**< distinct points the surface vote turned over
                                    (dacpo_params.surface_vote) */
+  size_t cue_reconciled_blocks; /**< blocks turned after stage 6 where their side
+                                     cue and the free space disagreed (the 0-1
+                                     program solved again, the shell pinned) */
   dacpo_scan_kind scan_kind;  /**< the kind the run used (never AUTO) */
   double single_view_fit;     /**< AUTO: how well one sensor position explains the
                                    sampling density (correlation, -1..1; >= 0.5:

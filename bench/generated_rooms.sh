@@ -1,0 +1,27 @@
+#!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
+# Eight generated rooms no parameter was tuned on (the `room` scene of
+# dacpo_make_scene, scene seeds 11-14, 100K points at sigma 4 mm and 60K at
+# sigma 8 mm), each oriented with run seeds 1-5 by bench/robustness.py:
+# median, worst seed, spread and the in-block / flip / component split.
+#
+# usage: bench/generated_rooms.sh [BUILD] [WORK] [-- robustness.py options]
+#   BUILD  build folder with wrappers/ (default: build)
+#   WORK   where the rooms and runs go (default: BUILD/generated_rooms)
+set -eu
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${1:-$ROOT/build}
+WORK=${2:-$BUILD/generated_rooms}
+[ $# -ge 1 ] && shift
+[ $# -ge 1 ] && [ "$1" != "--" ] && shift
+[ $# -ge 1 ] && [ "$1" = "--" ] && shift
+mkdir -p "$WORK/rooms"
+for s in 11 12 13 14; do
+  [ -f "$WORK/rooms/room_s${s}_n4.ply" ] ||
+    "$BUILD/wrappers/dacpo_make_scene" "$WORK/rooms/room_s${s}_n4.ply" -scene room \
+      -n 100000 -noise 0.004 -seed $s > /dev/null
+  [ -f "$WORK/rooms/room_s${s}_n8.ply" ] ||
+    "$BUILD/wrappers/dacpo_make_scene" "$WORK/rooms/room_s${s}_n8.ply" -scene room \
+      -n 60000 -noise 0.008 -seed $s > /dev/null
+done
+exec python3 "$ROOT/bench/robustness.py" -b "$BUILD" -w "$WORK" "$@" "$WORK/rooms"
