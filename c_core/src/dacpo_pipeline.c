@@ -396,9 +396,10 @@ block_edges(const run_state* s, dacpo_ilp_edge* ie)
 /* The 0-1 program fixes the lowest node of each component, so the anchor node
  * can end at 1: then every block joined to it is read the other way round. */
 static dacpo_status
-read_anchor(size_t nb, uint8_t* flips, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* err)
+read_anchor(run_state* s, const dacpo_ilp_edge* ie, size_t ne, dacpo_err* err)
 {
-  if (!flips[nb])
+  const size_t nb = s->blocks.num_blocks;
+  if (!s->flips[nb])
     return DACPO_OK;
   int32_t* root = dacpo_malloc_array(nb + 1, sizeof(int32_t));
   if (!root)
@@ -410,7 +411,7 @@ read_anchor(size_t nb, uint8_t* flips, const dacpo_ilp_edge* ie, size_t ne, dacp
   const int32_t ra = dacpo_uf_find(root, (int32_t)nb);
   for (size_t b = 0; b <= nb; ++b)
     if (dacpo_uf_find(root, (int32_t)b) == ra)
-      flips[b] = (uint8_t)!flips[b];
+      s->flips[b] = (uint8_t)!s->flips[b];
   free(root);
   return DACPO_OK;
 }
@@ -438,7 +439,7 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
                                    &s->ilp,
                                    err);
   if (r == DACPO_OK && na > 0)
-    r = read_anchor(nb, s->flips, ie, ne + na, err);
+    r = read_anchor(s, ie, ne + na, err);
   if (r == DACPO_OK)
     r = block_confidence(s, ie, ne + na, err);
   free(ie);
@@ -650,7 +651,8 @@ reconcile_cue_with_free_space(run_state* s, size_t* turned, dacpo_err* err)
         dacpo_uf_union(root, ie[e].a, ie[e].b);
     /* what turning its group over gains, summed at the group's root: the
      * anchor (w_same rewards the sign stage 3 left) and every edge with one
-     * end outside the group (its relation changes; inner ones keep theirs) */
+     * end outside the group (its relation changes; inner ones keep theirs;
+     * an edge between two groups counts for each as if the other stayed) */
     for (size_t t = ne; t < ne + na; ++t) {
       const size_t b = (size_t)ie[t].a;
       if (root[b] >= 0)
