@@ -45,6 +45,11 @@ dacpo_err_set(dacpo_err* err, dacpo_status code, const char* fmt, ...)
 double
 dacpo_now(void);
 
+/* Eigen-decomposition of a symmetric 3x3 matrix a (destroyed): eigenvalues in
+ * w, eigenvectors in the columns of v (v[row][col]), unsorted (Jacobi). */
+void
+dacpo_jacobi3(double a[3][3], double w[3], double v[3][3]);
+
 /* Quickselect: the k-th smallest of v[0..n), n > 0, k < n (v is permuted). */
 double
 dacpo_select_kth(double* v, size_t n, size_t k);

@@ -32,8 +32,8 @@ enum { NORMALS_CHUNK = 4096, JACOBI_MAX_SWEEPS = 50 };
 
 /* Eigen-decomposition of a symmetric 3x3 matrix a (destroyed): eigenvalues in
  * w, eigenvectors in the columns of v (v[row][col]), unsorted. */
-static void
-jacobi3(double a[3][3], double w[3], double v[3][3])
+void
+dacpo_jacobi3(double a[3][3], double w[3], double v[3][3])
 {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -151,7 +151,7 @@ pca_point(const dacpo_cloud* cloud,
     for (int r = 0; r < 3; ++r)
       for (int s = 0; s < 3; ++s)
         c[r][s] /= mx;
-    jacobi3(c, w, v);
+    dacpo_jacobi3(c, w, v);
   }
   int lo = 0;
   for (int d = 1; d < 3; ++d)

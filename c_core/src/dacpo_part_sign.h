@@ -80,9 +80,10 @@ dacpo_view_rng_seed(dacpo_rng* rng);
 void
 dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3]);
 
-/* Parts that wrap around their own centroid (closed objects): outward[c] = +1
- * if their normals (nrm, as they will be returned) face outward, -1 if inward,
- * 0 for every other part. Failures: NULL argument (INVALID_ARGUMENT),
+/* Parts that wrap around their own centroid (closed objects), and flat parts
+ * with two faces (a free-standing board: its faces look away from its
+ * mid-plane): outward[c] = +1 if their normals (nrm, as they will be returned)
+ * face outward, -1 if inward, 0 for every other part. Failures: NULL argument (INVALID_ARGUMENT),
  * OUT_OF_MEMORY. */
 dacpo_status
 dacpo_part_closed_outward(const double* xyz,

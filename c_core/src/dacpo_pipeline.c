@@ -744,8 +744,9 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 /* A part other than the largest that wraps around its own centroid is a
  * closed object seen from all round, which the viewpoint vote cannot place
- * (half its points face any viewpoint): after stage 6 it takes the sign under
- * which it faces outward (dacpo_part_closed_outward). The side cue, where it
+ * (half its points face any viewpoint), and so is a flat part with two faces
+ * (a free-standing board): after stage 6 it takes the sign under which it
+ * faces outward (dacpo_part_closed_outward). The side cue, where it
  * speaks, still has the last word (parts_follow_the_cue runs after). */
 static dacpo_status
 closed_parts_outward(run_state* s, size_t np, dacpo_err* err)

@@ -183,6 +183,44 @@ TEST(PartSign, ClosedPartsAreToldFromOpenOnesAndSayWhichWayIsOut)
   EXPECT_EQ(outward[0], 0) << "a part as large as the scene is not an object";
 }
 
+// A free-standing board (both faces sampled, 0.6 x 0.4 m, 2 cm thick, with a
+// 1 mm ripple so no offset is exactly 0) is a slab: its faces look away from
+// its mid-plane. A wall patch with a picture on it has one face: left alone.
+TEST(PartSign, SlabPartsSayWhichWayIsOut)
+{
+  Shapes s = closedAndOpenShapes();
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 20; ++j) {
+      const double x = 20.0 + 0.02 * i, y = 0.02 * j;
+      const double ripple = 0.001 * std::sin(1.7 * i + 2.3 * j);
+      s.add(x, y, 0.01 + ripple, 0.0, 0.0, 1.0, 4);   // top face, up
+      s.add(x + 0.01, y + 0.01, -0.01 - ripple, 0.0, 0.0, -1.0, 4); // bottom face, down
+      s.add(25.0 + x, y, 0.0005 * std::sin(3.1 * i + 0.7 * j), 0.0, 0.0, 1.0, 5); // wall
+      if (i >= 10 && i < 20 && j >= 5 && j < 15)
+        s.add(25.01 + x, y + 0.01, 0.03, 0.0, 0.0, 1.0, 5); // the picture's front
+    }
+  const size_t n = s.part.size();
+  int8_t outward[6];
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 6, outward, &err),
+            DACPO_OK)
+      << err.msg;
+  EXPECT_EQ(outward[4], 1) << "board, faces looking away from each other";
+  EXPECT_EQ(outward[5], 0) << "a wall with a picture has one face";
+  EXPECT_EQ(outward[3], 0) << "a flat square with one face";
+  EXPECT_EQ(outward[0], 1) << "the sphere is still told by the closed test";
+  for (size_t i = 0; i < n; ++i)
+    if (s.part[i] == 4 || s.part[i] == 5)
+      for (int d = 0; d < 3; ++d)
+        s.nrm[3 * i + d] = -s.nrm[3 * i + d];
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 6, outward, &err),
+            DACPO_OK);
+  EXPECT_EQ(outward[4], -1) << "board inside out";
+  EXPECT_EQ(outward[5], 0) << "the wall the other way round: still one face";
+}
+
 TEST(PartSign, ClosedPartsRefuseNullInput)
 {
   int8_t outward[2] = {5, 5};
