@@ -5,18 +5,34 @@
 # sigma 8 mm), each oriented with run seeds 1-5 by bench/robustness.py:
 # median, worst seed, spread and the in-block / flip / component split.
 #
-# usage: bench/generated_rooms.sh [BUILD] [WORK] [-- robustness.py options]
+# ROOMS=fused instead: the same four scenes (100K points, sigma 2 mm) fused
+# from 3 views 8 mm and 0.2 degrees apart (dacpo_make_scene -fused), so every
+# surface comes as offset copies (misregistered multi-view fusion).
+#
+# usage: [ROOMS=noisy|fused] bench/generated_rooms.sh [BUILD] [WORK] [-- robustness.py options]
 #   BUILD  build folder with wrappers/ (default: build)
-#   WORK   where the rooms and runs go (default: BUILD/generated_rooms)
+#   WORK   where the rooms and runs go (default: BUILD/generated_rooms, or
+#          BUILD/fused_rooms)
 set -eu
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$ROOT/build}
-WORK=${2:-$BUILD/generated_rooms}
+ROOMS=${ROOMS:-noisy}
+case "$ROOMS" in
+  noisy) WORK=${2:-$BUILD/generated_rooms} ;;
+  fused) WORK=${2:-$BUILD/fused_rooms} ;;
+  *) echo "ROOMS must be noisy or fused, got $ROOMS" >&2; exit 2 ;;
+esac
 [ $# -ge 1 ] && shift
 [ $# -ge 1 ] && [ "$1" != "--" ] && shift
 [ $# -ge 1 ] && [ "$1" = "--" ] && shift
 mkdir -p "$WORK/rooms"
 for s in 11 12 13 14; do
+  if [ "$ROOMS" = fused ]; then
+    [ -f "$WORK/rooms/fused_s${s}_v3.ply" ] ||
+      "$BUILD/wrappers/dacpo_make_scene" "$WORK/rooms/fused_s${s}_v3.ply" -scene room \
+        -n 100000 -noise 0.002 -fused 3,0.008,0.2 -seed $s > /dev/null
+    continue
+  fi
   [ -f "$WORK/rooms/room_s${s}_n4.ply" ] ||
     "$BUILD/wrappers/dacpo_make_scene" "$WORK/rooms/room_s${s}_n4.ply" -scene room \
       -n 100000 -noise 0.004 -seed $s > /dev/null

@@ -27,6 +27,7 @@
 #include "dacpo_scene_mesh.h"
 #include "dacpo_segment.h"
 #include "dacpo_surface_vote.h"
+#include "dacpo_layered.h"
 #include "dacpo_vcr.h"
 #include "dacpo_view_kind.h"
 
@@ -1138,6 +1139,7 @@ static dacpo_status
 resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   st->single_view_fit = 0.0;
+  st->layered_share = 0.0;
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
     double fit = 0.0, slope = 0.0;
     DACPO_TRY(dacpo_single_view_fit(
@@ -1145,6 +1147,21 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
     st->single_view_fit = fit;
     s->p.scan_kind =
         fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
+    /* Many views whose surfaces come as offset copies (fused with a
+     * registration error): the side cue would read each pair of copies as a
+     * thin solid's two faces (dacpo_layered.c), so it is left out. A kind
+     * given by the caller is taken as it is. */
+    if (s->p.scan_kind == DACPO_SCAN_MULTI_VIEW && s->p.dipole_sides > 0.0) {
+      DACPO_TRY(dacpo_layered_share(s->cloud.xyz,
+                                    s->cloud.nrm,
+                                    s->cloud.n,
+                                    s->knn.sqd,
+                                    s->knn.k,
+                                    &st->layered_share,
+                                    err));
+      if (st->layered_share >= DACPO_LAYERED_SHARE)
+        s->p.dipole_sides = 0.0;
+    }
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;
   if (s->p.dipole_layers < 0.0) /* layers 0.5 spacings apart are depth steps */
@@ -1159,6 +1176,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->dipole_two_sheet_used = s->p.dipole_two_sheet;
   st->dipole_c_used = s->p.dipole_c;
   st->dipole_layers_used = s->p.dipole_layers;
+  st->dipole_sides_used = s->p.dipole_sides;
   st->scan_kind = s->p.scan_kind;
   return DACPO_OK;
 }

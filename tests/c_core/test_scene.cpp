@@ -820,3 +820,50 @@ TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
       DACPO_PLY_ERR_ARGUMENT);
   std::remove(path.c_str());
 }
+
+// Fused views: view 0 stays where it is, every other view is moved rigidly by
+// about fused_shift (plus the rotation's share), normals turn with it (unit
+// length kept); bad values are refused.
+TEST(DacpoScene, FusedViewsMoveCopiesRigidly)
+{
+  dacpo_scene_params sp;
+  dacpo_scene_params_init(&sp);
+  sp.target_points = 20000;
+  dacpo_scene plain{}, fused{};
+  char err[256] = "";
+  ASSERT_EQ(dacpo_scene_generate(&sp, &plain, err, sizeof(err)), 0) << err;
+  sp.fused_views = 3;
+  sp.fused_shift = 0.01;
+  sp.fused_angle = 0.2;
+  ASSERT_EQ(dacpo_scene_generate(&sp, &fused, err, sizeof(err)), 0) << err;
+  ASSERT_EQ(plain.n, fused.n);
+  size_t same = 0, moved = 0;
+  for (size_t i = 0; i < plain.n; ++i) {
+    double d2 = 0.0, len2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = (double)fused.xyz[3 * i + k] - (double)plain.xyz[3 * i + k];
+      d2 += d * d;
+      len2 += (double)fused.normals[3 * i + k] * (double)fused.normals[3 * i + k];
+    }
+    EXPECT_NEAR(len2, 1.0, 1e-5);
+    same += d2 < 1e-12;
+    // a 0.2 degree turn moves a point of a 6 m room by at most ~1.4 cm
+    moved += d2 > 1e-8 && d2 < 0.03 * 0.03;
+  }
+  // one view in three stays in place, the others move by millimetres
+  EXPECT_GT(same, plain.n / 4);
+  EXPECT_LT(same, plain.n / 2);
+  EXPECT_EQ(same + moved, plain.n);
+  dacpo_scene_free(&plain);
+  dacpo_scene_free(&fused);
+
+  dacpo_scene bad{};
+  sp.fused_views = DACPO_SCENE_MAX_FUSED_VIEWS + 1;
+  EXPECT_EQ(dacpo_scene_generate(&sp, &bad, err, sizeof(err)), -1);
+  sp.fused_views = 3;
+  sp.fused_shift = -1.0;
+  EXPECT_EQ(dacpo_scene_generate(&sp, &bad, err, sizeof(err)), -1);
+  sp.fused_shift = 0.01;
+  sp.fused_angle = NAN;
+  EXPECT_EQ(dacpo_scene_generate(&sp, &bad, err, sizeof(err)), -1);
+}

@@ -225,6 +225,8 @@ statsDict(const dacpo_stats* s)
   stats["sign_enclosed"] = s->sign_enclosed != 0;
   stats["scan_kind"] = s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
   stats["single_view_fit"] = s->single_view_fit;
+  stats["layered_share"] = s->layered_share;
+  stats["dipole_sides_used"] = s->dipole_sides_used;
   stats["dipole_c_used"] = s->dipole_c_used;
   stats["dipole_layers_used"] = s->dipole_layers_used;
   stats["dipole_two_sheet_used"] = s->dipole_two_sheet_used;

@@ -45,7 +45,8 @@ enum {
   STREAM_GEOMETRY = 1,
   STREAM_DOWNSAMPLE = 2,
   STREAM_NOISE = 3,
-  STREAM_SCRAMBLE = 4
+  STREAM_SCRAMBLE = 4,
+  STREAM_FUSED = 5
 };
 
 /* ------------------------------------------------------------------------- */
@@ -750,6 +751,9 @@ dacpo_scene_params_init(dacpo_scene_params* params)
   params->noise_sigma = 0.0;
   params->downsample_to = 0;
   params->seed = 1;
+  params->fused_views = 0;
+  params->fused_shift = 0.01;
+  params->fused_angle = 0.2;
 }
 
 void
@@ -856,6 +860,51 @@ add_noise(dacpo_scene* s, double sigma, uint64_t seed)
   }
 }
 
+/* Views fused with a registration error: point i belongs to a random one of
+ * `views`; view v > 0 is turned by `angle_deg` about a random axis through the
+ * scene's centre and moved by `shift` in a random direction (its normals turn
+ * with it, so the ground truth stays that of the surface each copy shows). */
+static void
+fuse_views(dacpo_scene* s, unsigned views, double shift, double angle_deg, uint64_t seed)
+{
+  dacpo_rng r;
+  dacpo_rng_seed(&r, seed, STREAM_FUSED);
+  double c[3] = {0.0, 0.0, 0.0};
+  for (size_t i = 0; i < s->n; ++i)
+    for (int k = 0; k < 3; ++k)
+      c[k] += (double)s->xyz[3 * i + k] / (double)s->n;
+  double rot[DACPO_SCENE_MAX_FUSED_VIEWS][9], move[DACPO_SCENE_MAX_FUSED_VIEWS][3];
+  for (unsigned v = 0; v < views; ++v) {
+    double a[3], t[3];
+    rng_unit_vector(&r, a);
+    rng_unit_vector(&r, t);
+    /* Rodrigues: R = I + sin(th) K + (1 - cos(th)) K^2, K the cross matrix of a */
+    const double th = v == 0 ? 0.0 : angle_deg * (3.14159265358979323846 / 180.0);
+    const double K[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double k2 = 0.0;
+        for (int m = 0; m < 3; ++m)
+          k2 += K[3 * i + m] * K[3 * m + j];
+        rot[v][3 * i + j] = (i == j) + sin(th) * K[3 * i + j] + (1.0 - cos(th)) * k2;
+      }
+    for (int k = 0; k < 3; ++k)
+      move[v][k] = v == 0 ? 0.0 : shift * t[k];
+  }
+  for (size_t i = 0; i < s->n; ++i) {
+    const size_t v = dacpo_rng_below(&r, views);
+    float* p = s->xyz + 3 * i;
+    float* q = s->normals + 3 * i;
+    const double d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const double m[3] = {q[0], q[1], q[2]};
+    for (int k = 0; k < 3; ++k) {
+      const double* R = rot[v] + 3 * k;
+      p[k] = (float)(c[k] + R[0] * d[0] + R[1] * d[1] + R[2] * d[2] + move[v][k]);
+      q[k] = (float)(R[0] * m[0] + R[1] * m[1] + R[2] * m[2]);
+    }
+  }
+}
+
 /* The parameters dacpo_scene_generate accepts (0, or SCENE_ERR_INVALID with
  * a message). */
 static int
@@ -878,6 +927,18 @@ check_scene_params(const dacpo_scene_params* params, char* err, size_t errlen)
   if (!(params->noise_sigma >= 0.0) || !isfinite(params->noise_sigma)) {
     dacpo_support_err(
         err, errlen, "noise_sigma %g must be finite and >= 0", params->noise_sigma);
+    return SCENE_ERR_INVALID;
+  }
+  if (params->fused_views > DACPO_SCENE_MAX_FUSED_VIEWS ||
+      !(params->fused_shift >= 0.0) || !isfinite(params->fused_shift) ||
+      !(params->fused_angle >= 0.0) || !isfinite(params->fused_angle)) {
+    dacpo_support_err(err,
+                      errlen,
+                      "fused views %u (at most %d), shift %g and angle %g must be finite and >= 0",
+                      params->fused_views,
+                      DACPO_SCENE_MAX_FUSED_VIEWS,
+                      params->fused_shift,
+                      params->fused_angle);
     return SCENE_ERR_INVALID;
   }
   if (params->downsample_to > n) {
@@ -983,6 +1044,8 @@ dacpo_scene_generate(const dacpo_scene_params* params,
   sample_patches(&b, counts, params->seed, &s);
   if (params->downsample_to > 0 && params->downsample_to < s.n)
     downsample(&s, params->downsample_to, params->seed);
+  if (params->fused_views > 1)
+    fuse_views(&s, params->fused_views, params->fused_shift, params->fused_angle, params->seed);
   if (params->noise_sigma > 0.0)
     add_noise(&s, params->noise_sigma, params->seed);
 

@@ -83,6 +83,9 @@ typedef enum dacpo_scene_kind {
 #define DACPO_SCENE_ROOM_SIZE_Y 5.0
 #define DACPO_SCENE_ROOM_HEIGHT 2.6
 
+/** \brief Most views dacpo_scene_params::fused_views takes. */
+#define DACPO_SCENE_MAX_FUSED_VIEWS 16
+
 /** \brief Generation parameters; fill with dacpo_scene_params_init() first. */
 typedef struct dacpo_scene_params {
   unsigned kind;        /**< a ::dacpo_scene_kind; default DACPO_SCENE_ROOM */
@@ -92,6 +95,15 @@ typedef struct dacpo_scene_params {
   size_t downsample_to; /**< keep a random subset of this many points (order
                              preserved); 0 = keep all; default 0 */
   uint64_t seed;        /**< default 1 */
+  unsigned fused_views; /**< views fused with a registration error: every point
+                             belongs to one of them at random, and each view but
+                             the first is moved by its own rigid error (below),
+                             so every surface comes as offset copies; 0 or 1 =
+                             none; default 0 */
+  double fused_shift;   /**< the error's translation, metres (each view: this
+                             length in a random direction); default 0.01 */
+  double fused_angle;   /**< the error's rotation about the scene's centre,
+                             degrees (random axis); default 0.2 */
 } dacpo_scene_params;
 
 /** \brief A generated scene. All arrays are owned; free with dacpo_scene_free(). */
@@ -126,7 +138,8 @@ dacpo_scene_params_init(dacpo_scene_params* params);
  * \param[in]  errlen  size of err
  * \return 0 on success; -1 for invalid arguments (NULL pointer, unknown kind,
  *         target_points == 0, negative or non-finite noise, downsample_to >
- *         target_points), -2 when out of memory.
+ *         target_points, negative or non-finite fused_shift / fused_angle),
+ *         -2 when out of memory.
  * Cost: O(target_points) time and memory (28 bytes per point).
  */
 int

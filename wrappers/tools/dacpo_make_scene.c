@@ -4,7 +4,7 @@
  * little-endian PLY (float x y z nx ny nz). Plain C, needs only dacpo_support.
  *
  *   dacpo_make_scene out.ply [-scene room] [-n 100000] [-noise 0] [-downsample 0]
- *                            [-seed 1] [-offset X,Y,Z] [-scale S]
+ *                            [-fused V,SHIFT,DEG] [-seed 1] [-offset X,Y,Z] [-scale S]
  *
  * -offset moves the scene and -scale scales it (x S, then + offset); both write
  * double x y z (georeferenced scans: in float, an offset of 5e6 m leaves a
@@ -77,6 +77,11 @@ print_help(const char* prog)
   printf(
       "  -downsample M    keep a random subset of M points, 0 = all (default: %zu)\n",
       d.downsample_to);
+  printf("  -fused V,SHIFT,DEG  fuse V views with a registration error: each point\n"
+         "                   belongs to one at random, each view but the first moved\n"
+         "                   by SHIFT metres and turned by DEG degrees (random\n"
+         "                   directions), so surfaces come as offset copies, e.g.\n"
+         "                   3,0.008,0.2 (default: none)\n");
   printf("  -seed S          random seed (default: %llu)\n",
          (unsigned long long)d.seed);
   printf("  -offset X,Y,Z    add this offset and write double x y z (as georeferenced\n"
@@ -161,7 +166,7 @@ apply_option(const char* prog, const char* a, const char* v, make_options* o)
   dacpo_scene_params* p = &o->p;
   if (strcmp(a, "-scene") && strcmp(a, "-n") && strcmp(a, "-noise") &&
       strcmp(a, "-downsample") && strcmp(a, "-seed") && strcmp(a, "-offset") &&
-      strcmp(a, "-scale"))
+      strcmp(a, "-scale") && strcmp(a, "-fused"))
     return usage_error(prog, "unknown option", a);
   if (!v)
     return usage_error(prog, "missing value after", a);
@@ -184,6 +189,15 @@ apply_option(const char* prog, const char* a, const char* v, make_options* o)
   else if (strcmp(a, "-seed") == 0) {
     if (parse_u64(v, &p->seed) != 0)
       return usage_error(prog, "-seed needs an integer >= 0, got", v);
+  }
+  else if (strcmp(a, "-fused") == 0) {
+    char tail = 0;
+    if (sscanf(v, "%u,%lf,%lf%c", &p->fused_views, &p->fused_shift, &p->fused_angle, &tail) !=
+            3 ||
+        p->fused_views > DACPO_SCENE_MAX_FUSED_VIEWS || !isfinite(p->fused_shift) ||
+        !(p->fused_shift >= 0.0) || !isfinite(p->fused_angle) || !(p->fused_angle >= 0.0))
+      return usage_error(
+          prog, "-fused needs V,SHIFT,DEG (V <= 16, SHIFT and DEG finite >= 0), got", v);
   }
   else if (strcmp(a, "-offset") == 0) {
     char tail = 0;

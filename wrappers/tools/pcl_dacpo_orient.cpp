@@ -342,8 +342,10 @@ const OptionSpec kOptions[] = {
      "kind of scan: one depth view (single: layers face one way,\n"
      "no thin part shows two faces) or seen from many places\n"
      "(multi: fused scans, sampled models; the thin-part side cue\n"
-     "in every block); auto decides from the sampling density\n"
-     "(default: auto)",
+     "in every block); auto decides from the sampling density, and\n"
+     "leaves the side cue out where the largest plane (a floor)\n"
+     "shows offset copies of itself (views fused with a\n"
+     "registration error; stats layered=, sides=) (default: auto)",
      nullptr,
      [](Options& o, const std::string& s, std::string& error) {
        if (s == "auto")
@@ -1224,7 +1226,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu scan=%s single_view_fit=%.3f c=%g "
-               "layers=%g two_sheet=%g "
+               "layers=%g two_sheet=%g layered=%.3f sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1246,6 +1248,8 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.dipole_c_used,
                s.dipole_layers_used,
                s.dipole_two_sheet_used,
+               s.layered_share,
+               s.dipole_sides_used,
                s.sign_flipped,
                s.sign_facing,
                s.sign_enclosed,

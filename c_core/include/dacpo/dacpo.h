@@ -417,8 +417,9 @@ typedef struct dacpo_stats {
   size_t surface_vote_turned; /**< distinct points the surface vote turned over
                                    (dacpo_params.surface_vote) */
   size_t cue_reconciled_blocks; /**< blocks turned after stage 6 where their side
-                                     cue and the free space disagreed (the 0-1
-                                     program solved again, the shell pinned) */
+                                     cue and the free space disagreed (groups of
+                                     blocks against their cue whose anchors
+                                     outweigh the edges joining them to the rest) */
   dacpo_scan_kind scan_kind;  /**< the kind the run used (never AUTO) */
   double single_view_fit;     /**< AUTO: how well one sensor position explains the
                                    sampling density (correlation, -1..1; >= 0.5:
@@ -426,6 +427,13 @@ typedef struct dacpo_stats {
   double dipole_c_used;       /**< dipole_c the run used (resolved when < 0) */
   double dipole_layers_used;  /**< dipole_layers the run used (resolved when < 0) */
   double dipole_two_sheet_used; /**< dipole_two_sheet the run used (resolved when < 0) */
+  double layered_share;       /**< AUTO resolved to many views: share of the largest
+                                   plane's sampled points where the side test finds
+                                   a second face (>= 0.03: the surfaces come as
+                                   offset copies, the side cue is left out); 0
+                                   when the test did not run */
+  double dipole_sides_used;   /**< dipole_sides the run used (0 when the layered
+                                   test left the side cue out) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */
