@@ -105,7 +105,23 @@ find_band(const double* xyz,
     }
     if (best < DACPO_LAYERED_MIN_BAND)
       break;
+    /* One point's axis can be a few degrees off the plane's, which tilts the
+     * slab across a large floor (2 degrees: 21 cm over 6 m); the mean of the
+     * parallel axes (twice) is not. */
     memcpy(dirs[r], axes + 3 * probe[best_c], sizeof(dirs[r]));
+    for (int it = 0; it < 2; ++it) {
+      double mean[3] = {0.0, 0.0, 0.0};
+      for (size_t t = 0; t < m; ++t) {
+        const double* a = axes + 3 * probe[t];
+        const double d = dot3(a, dirs[r]);
+        if (fabs(d) > LAYERED_COS)
+          for (int k = 0; k < 3; ++k)
+            mean[k] += d > 0.0 ? a[k] : -a[k];
+      }
+      const double len = sqrt(dot3(mean, mean));
+      for (int k = 0; k < 3 && len > 0.0; ++k)
+        dirs[r][k] = mean[k] / len;
+    }
     size_t k = 0;
     for (size_t t = 0; t < m; ++t)
       if (fabs(dot3(dirs[r], axes + 3 * probe[t])) > LAYERED_COS)

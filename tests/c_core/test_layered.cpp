@@ -84,12 +84,9 @@ orientScore(const dacpo_scene& sc, dacpo_scan_kind kind, dacpo_stats* stats)
 
 } // namespace
 
-// Scene seeds 2-4. On scene seed 1 the share is 0.076, under the threshold:
-// there the views' errors hardly move the floor's copies apart (a known miss,
-// see DESIGN.md).
 TEST(DacpoLayered, FusedRoomShowsCopiesAPlainOneDoesNot)
 {
-  for (uint64_t seed = 2; seed <= 4; ++seed) {
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
     GeneratedScene fused(roomParams(100000, 3, seed)), plain(roomParams(100000, 0, seed));
     ASSERT_TRUE(fused.ok && plain.ok);
     const double f = shareOf(fused.s.xyz, fused.s.normals, fused.s.n);
