@@ -478,6 +478,13 @@ dacpo_calloc_array(size_t count, size_t size)
   return calloc(count ? count : 1, size ? size : 1);
 }
 
+int
+dacpo_cmp_double(const void* a, const void* b)
+{
+  const double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
 /* Quickselect: the k-th smallest of v[0..n) (v is permuted). */
 double
 dacpo_select_kth(double* v, size_t n, size_t k)

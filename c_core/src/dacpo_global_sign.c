@@ -91,13 +91,6 @@ cmp_cell(const void* a, const void* b)
 }
 
 static int
-cmp_double(const void* a, const void* b)
-{
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static int
 cmp_candidate(const void* a, const void* b)
 {
   const gs_candidate* x = a;
@@ -136,7 +129,7 @@ visible_share(const dacpo_view_sample* s,
     return -1.0;
   }
   memcpy(tmp, r, s->m * sizeof(double));
-  qsort(tmp, s->m, sizeof(double), cmp_double);
+  qsort(tmp, s->m, sizeof(double), dacpo_cmp_double);
   const double median = tmp[s->m / 2];
   free(tmp);
   const double cell_angle = spacing / fmax(median, spacing);

@@ -54,6 +54,10 @@ dacpo_jacobi3(double a[3][3], double w[3], double v[3][3]);
 double
 dacpo_select_kth(double* v, size_t n, size_t k);
 
+/* qsort comparator for doubles, ascending. */
+int
+dacpo_cmp_double(const void* a, const void* b);
+
 /* A triangle mesh. Winding is counter-clockwise seen from the side the
  * (oriented) normals point to: the face normal (v1-v0)x(v2-v0) agrees with the
  * block's point normals. */

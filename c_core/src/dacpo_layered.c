@@ -48,13 +48,6 @@ dot3(const double* a, const double* b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static int
-cmp_double(const void* a, const void* b)
-{
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
 /* The densest window [lo, lo + width] of the m sorted values h: its count. */
 static size_t
 densest_window(const double* h, size_t m, double width, double* lo)
@@ -126,7 +119,7 @@ find_band(const double* xyz,
     for (size_t t = 0; t < m; ++t)
       if (fabs(dot3(dirs[r], axes + 3 * probe[t])) > LAYERED_COS)
         h[k++] = dot3(dirs[r], xyz + 3 * probe[t]);
-    qsort(h, k, sizeof(double), cmp_double);
+    qsort(h, k, sizeof(double), dacpo_cmp_double);
     double at = 0.0;
     const size_t count = densest_window(h, k, width, &at);
     if (count > best_band) {

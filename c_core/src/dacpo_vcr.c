@@ -270,13 +270,6 @@ typedef struct view_result {
   size_t pix[2], cross_same, cross_diff, regions[2];
 } view_result;
 
-static int
-cmp_double(const void* x, const void* y)
-{
-  double a = *(const double*)x, b = *(const double*)y;
-  return (a > b) - (a < b);
-}
-
 /* Median edge length over an even sample of at most 341 triangles (1023 edges):
  * the scale of a face, hence of the seams between two meshes cut face by face. */
 static double
@@ -293,7 +286,7 @@ median_edge_length(const vcr_work* w)
     }
   if (n == 0)
     return 0.0;
-  qsort(len, n, sizeof(double), cmp_double);
+  qsort(len, n, sizeof(double), dacpo_cmp_double);
   return len[n / 2];
 }
 
