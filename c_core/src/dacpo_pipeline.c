@@ -1170,9 +1170,13 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
    * ("opposite"), which there is only ever noise or layers. */
   if (s->p.dipole_c < 0.0)
     s->p.dipole_c = single ? 1.0 : 1.5;
-  /* ... and the two-sheet rule, whose pairs there are layers or noise. */
+  /* ... and the two-sheet rule and the side cue, whose pairs there are
+   * layers, noise, or the offset copies of views fused into a cloud that
+   * passes for one view. */
   if (s->p.dipole_two_sheet < 0.0)
     s->p.dipole_two_sheet = single ? 0.0 : 3.0;
+  if (single)
+    s->p.dipole_sides = 0.0;
   st->dipole_two_sheet_used = s->p.dipole_two_sheet;
   st->dipole_c_used = s->p.dipole_c;
   st->dipole_layers_used = s->p.dipole_layers;

@@ -253,7 +253,9 @@ typedef struct dacpo_params {
                                       Seeds 1-5, 18 rooms / 15 depth frames, % wrong:
                                       off 8.01 / 3.66, 0.001 7.40 / 3.66, 0.5 7.01 /
                                       3.66 (larger seed spread, a generated 20K room
-                                      7.6-13.1 %). 0 = off (0.001) */
+                                      7.6-13.1 %). Left out where the scan
+                                      kind resolves to one depth view. 0 = off
+                                      (0.001) */
   double cue_anchor;             /**< stage 5: the side cue (dipole_sides) is an
                                       absolute sign - the two faces of a thin part look
                                       away from each other - so a block where it fired
@@ -429,11 +431,12 @@ typedef struct dacpo_stats {
   double dipole_two_sheet_used; /**< dipole_two_sheet the run used (resolved when < 0) */
   double layered_share;       /**< AUTO resolved to many views: share of the largest
                                    plane's sampled points where the side test finds
-                                   a second face (>= 0.03: the surfaces come as
+                                   a second face (>= 0.065: the surfaces come as
                                    offset copies, the side cue is left out); 0
                                    when the test did not run */
   double dipole_sides_used;   /**< dipole_sides the run used (0 when the layered
-                                   test left the side cue out) */
+                                   test left the side cue out, or the scan
+                                   resolved to one depth view) */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */
