@@ -22,6 +22,14 @@
  * from inside). The side test runs on up to DACPO_LAYERED_SAMPLE band
  * points with their 32 nearest neighbours among all points near the band.
  *
+ * The side test sees copies that split cleanly in two; real scans of 20 or
+ * more frames stack them into a thick layer it does not split. The copy rate
+ * counts instead the points of the band's surface that have any second
+ * parallel sheet within two spacings (stage 2's two-sheet pair test): on a
+ * room's floor that happens only where a thing rests a spacing above it, on a
+ * fused floor everywhere. From DACPO_LAYERED_COPIES on the two-sheet rule goes
+ * too.
+ *
  * Cost: O(n) passes plus a kd-tree over the slab's points and the side test on
  * the sample (a few milliseconds on 100K points). Deterministic.
  */
@@ -34,18 +42,100 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define LAYERED_COS 0.985   /* parallel to a main direction: within ~10 degrees */
-#define LAYERED_ORTHO 0.2   /* a later direction: |a.d| below this for the earlier ones */
+#define LAYERED_COS 0.985 /* parallel to a main direction: within ~10 degrees */
+#define LAYERED_ORTHO 0.2 /* a later direction: |a.d| below this for the earlier ones  \
+                           */
 #define LAYERED_DIRECTIONS 3
-#define LAYERED_PROBE 4096  /* points sampled to find the band */
+#define LAYERED_PROBE 4096 /* points sampled to find the band */
 #define LAYERED_CANDIDATES 256
-#define LAYERED_BAND 3.0    /* band thickness, spacings */
-#define LAYERED_K 32        /* neighbours of the side test (as stage 2 on many views) */
+#define LAYERED_BAND 3.0 /* band thickness, spacings */
+#define LAYERED_K 32     /* neighbours of the side test (as stage 2 on many views) */
+
+#define LAYERED_NOISE_K 16 /* neighbours of the local noise scale (as stage 2) */
+#define LAYERED_PAIR_COS 0.8
+#define LAYERED_PAIR_NOISE 3.0
+#define LAYERED_PAIR_MIN 0.5 /* x spacing */
+#define LAYERED_PAIR_MAX 2.0 /* x local spacing */
+#define LAYERED_PAIRS 3
 
 static double
 dot3(const double* a, const double* b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double
+offset(const double* p, const double* a, const double* q)
+{
+  return (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
+}
+
+/* The 25th percentile of |offset| of point i's nearest from its tangent plane. */
+static double
+local_noise(
+    const double* xyz, const double* axes, const int32_t* idx, size_t k, size_t i)
+{
+  double off[LAYERED_NOISE_K];
+  const size_t m = k < LAYERED_NOISE_K ? k : LAYERED_NOISE_K;
+  size_t got = 0;
+  for (size_t t = 0; t < m; ++t)
+    if (idx[i * k + t] >= 0)
+      off[got++] =
+          fabs(offset(xyz + 3 * i, axes + 3 * i, xyz + 3 * (size_t)idx[i * k + t]));
+  return got ? dacpo_select_kth(off, got, got / 4) : 0.0;
+}
+
+/* Mean distance of point i's 4 nearest. */
+static double
+local_spacing(const float* sqd, size_t k, size_t i)
+{
+  const size_t m = k < 4 ? k : 4;
+  double sum = 0.0;
+  size_t got = 0;
+  for (size_t t = 0; t < m; ++t)
+    if (isfinite(sqd[i * k + t])) {
+      sum += sqrt((double)sqd[i * k + t]);
+      got++;
+    }
+  return got ? sum / (double)got : 0.0;
+}
+
+/* 1 if point i has a second parallel sheet among its neighbours. */
+static int
+has_second_sheet(const double* xyz,
+                 const double* axes,
+                 const int32_t* idx,
+                 const float* sqd,
+                 size_t k,
+                 size_t i,
+                 double spacing)
+{
+  const double* p = xyz + 3 * i;
+  const double* a = axes + 3 * i;
+  const double noise_i = local_noise(xyz, axes, idx, k, i);
+  const double local_i = local_spacing(sqd, k, i);
+  size_t pairs = 0;
+  for (size_t t = 0; t < k && pairs < LAYERED_PAIRS; ++t) {
+    if (idx[i * k + t] < 0)
+      continue;
+    const size_t j = (size_t)idx[i * k + t];
+    const double* b = axes + 3 * j;
+    const double ab = dot3(a, b);
+    if (j == i || fabs(ab) < LAYERED_PAIR_COS)
+      continue;
+    const double oa = fabs(offset(p, a, xyz + 3 * j));
+    const double ob = fabs(offset(p, b, xyz + 3 * j));
+    const double o = oa < ob ? oa : ob;
+    const double noise = fmax(noise_i, local_noise(xyz, axes, idx, k, j));
+    const double rr =
+        dot3(xyz + 3 * j, xyz + 3 * j) - 2.0 * dot3(p, xyz + 3 * j) + dot3(p, p);
+    const double lateral = sqrt(fmax(rr - oa * oa, 0.0));
+    const double tau = fmax(LAYERED_PAIR_NOISE * noise, LAYERED_PAIR_MIN * spacing) +
+                       lateral * sqrt(fmax(1.0 - ab * ab, 0.0));
+    const double local = fmax(local_i, local_spacing(sqd, k, j));
+    pairs += o > tau && o < LAYERED_PAIR_MAX * local;
+  }
+  return pairs >= LAYERED_PAIRS;
 }
 
 /* The densest window [lo, lo + width] of the m sorted values h: its count. */
@@ -131,21 +221,113 @@ find_band(const double* xyz,
   return best_band;
 }
 
+/* 1 if the band [lo, lo + width] along dir spans the scene: the smaller of
+ * its two extents in the plane is at least the depth of the scene along dir.
+ * A floor spans the room above it; a strip of an object's curved wall with
+ * the object on one side (a tube seen from outside) does not. */
+static int
+spans_scene(const double* xyz,
+            const double* axes,
+            size_t n,
+            const double dir[3],
+            double lo,
+            double width)
+{
+  const double h[3] = {
+      fabs(dir[0]) < 0.9 ? 1.0 : 0.0, fabs(dir[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+  double e1[3] = {dir[1] * h[2] - dir[2] * h[1],
+                  dir[2] * h[0] - dir[0] * h[2],
+                  dir[0] * h[1] - dir[1] * h[0]};
+  const double l = sqrt(dot3(e1, e1));
+  for (int d = 0; d < 3; ++d)
+    e1[d] /= l;
+  const double e2[3] = {dir[1] * e1[2] - dir[2] * e1[1],
+                        dir[2] * e1[0] - dir[0] * e1[2],
+                        dir[0] * e1[1] - dir[1] * e1[0]};
+  double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY, depth = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    const double y = dot3(dir, p);
+    depth = fmax(depth, fmax(lo - y, y - lo - width));
+    if (y < lo || y > lo + width || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+      continue;
+    lo1 = fmin(lo1, dot3(e1, p));
+    hi1 = fmax(hi1, dot3(e1, p));
+    lo2 = fmin(lo2, dot3(e2, p));
+    hi2 = fmax(hi2, dot3(e2, p));
+  }
+  return fmin(hi1 - lo1, hi2 - lo2) >= depth;
+}
+
+/* The copy rate of the band [lo, lo + width] along dir (nb_band points):
+ * the share of up to DACPO_LAYERED_SAMPLE points of the surface itself with a
+ * second parallel sheet (stage 2's two-sheet pair test). */
+static dacpo_status
+copy_rate(const double* xyz,
+          const double* axes,
+          size_t n,
+          const int32_t* knn_idx,
+          const float* knn_sqd,
+          size_t knn_k,
+          const double dir[3],
+          double lo,
+          double width,
+          size_t nb_band,
+          double spacing,
+          double* rate,
+          dacpo_err* err)
+{
+  /* The surface itself: the densest slab one spacing thick within the band
+   * (a thing resting a spacing above the floor is not sampled; a copy of the
+   * floor within two spacings of the slab still counts). */
+  double* y = dacpo_malloc_array(nb_band, sizeof(double));
+  if (!y)
+    return DACPO_OOM(err);
+  size_t ny = 0;
+  for (size_t i = 0; i < n && ny < nb_band; ++i) {
+    const double yi = dot3(dir, xyz + 3 * i);
+    if (yi >= lo && yi <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS)
+      y[ny++] = yi;
+  }
+  qsort(y, ny, sizeof(double), dacpo_cmp_double);
+  double at = lo;
+  const size_t on_surface = densest_window(y, ny, spacing, &at);
+  free(y);
+  /* every (on_surface / s)-th point of it */
+  const size_t s =
+      on_surface < DACPO_LAYERED_SAMPLE ? on_surface : DACPO_LAYERED_SAMPLE;
+  size_t seen = 0, taken = 0, copies = 0;
+  for (size_t i = 0; i < n && taken < s; ++i) {
+    const double yi = dot3(dir, xyz + 3 * i);
+    if (yi < at || yi > at + spacing || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+      continue;
+    if (seen++ * s >= taken * on_surface) {
+      taken++;
+      copies += has_second_sheet(xyz, axes, knn_idx, knn_sqd, knn_k, i, spacing);
+    }
+  }
+  *rate = taken ? (double)copies / (double)taken : 0.0;
+  return DACPO_OK;
+}
+
 dacpo_status
 dacpo_layered_share(const double* xyz,
                     const double* axes,
                     size_t n,
+                    const int32_t* knn_idx,
                     const float* knn_sqd,
                     size_t knn_k,
                     double* share,
+                    double* copies,
                     dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && axes && knn_sqd && share,
+              xyz && axes && knn_idx && knn_sqd && share && copies,
               DACPO_ERR_INVALID_ARGUMENT,
               "layered test: NULL argument");
   *share = 0.0;
-  if (n <= LAYERED_K || knn_k == 0)
+  *copies = 0.0;
+  if (n <= LAYERED_K || knn_k < LAYERED_PAIRS)
     return DACPO_OK;
   const size_t m = n < LAYERED_PROBE ? n : LAYERED_PROBE;
   size_t* probe = dacpo_malloc_array(m, sizeof(size_t));
@@ -184,7 +366,8 @@ dacpo_layered_share(const double* xyz,
       above++;
     else {
       ns++;
-      nb_band += y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
+      nb_band +=
+          y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
     }
   }
   /* Only a plane with the scene on one side of it, like a floor or a wall
@@ -196,6 +379,20 @@ dacpo_layered_share(const double* xyz,
       (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n ||
       (double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
     return DACPO_OK;
+  if (spans_scene(xyz, axes, n, dir, lo, width))
+    DACPO_TRY(copy_rate(xyz,
+                        axes,
+                        n,
+                        knn_idx,
+                        knn_sqd,
+                        knn_k,
+                        dir,
+                        lo,
+                        width,
+                        nb_band,
+                        spacing,
+                        copies,
+                        err));
   const size_t s = nb_band < DACPO_LAYERED_SAMPLE ? nb_band : DACPO_LAYERED_SAMPLE;
   const size_t nl = s * (LAYERED_K + 1);
   double* sxyz = dacpo_malloc_array(3 * ns, sizeof(double));
@@ -208,8 +405,8 @@ dacpo_layered_share(const double* xyz,
   int32_t idx[LAYERED_K + 1];
   double d2[LAYERED_K + 1];
   dacpo_kdtree* tree = NULL;
-  dacpo_status st = sxyz && saxes && pick && lxyz && laxes && lnb && side ? DACPO_OK
-                                                                           : DACPO_OOM(err);
+  dacpo_status st =
+      sxyz && saxes && pick && lxyz && laxes && lnb && side ? DACPO_OK : DACPO_OOM(err);
   size_t at = 0, seen = 0, taken = 0;
   for (size_t i = 0; i < n && st == DACPO_OK; ++i) {
     const double y = dot3(dir, xyz + 3 * i);
@@ -230,7 +427,8 @@ dacpo_layered_share(const double* xyz,
   /* local set: the s sample points, then each one's neighbours (copies; their
    * own rows point at themselves, so the test stays silent on them) */
   for (size_t t = 0; t < s && st == DACPO_OK; ++t) {
-    const size_t got = dacpo_kdtree_knn(tree, sxyz + 3 * pick[t], LAYERED_K + 1, idx, d2);
+    const size_t got =
+        dacpo_kdtree_knn(tree, sxyz + 3 * pick[t], LAYERED_K + 1, idx, d2);
     memcpy(lxyz + 3 * t, sxyz + 3 * pick[t], 3 * sizeof(double));
     memcpy(laxes + 3 * t, saxes + 3 * pick[t], 3 * sizeof(double));
     size_t row = 0;

@@ -16,17 +16,31 @@
  * values measured). 0 when no band holds DACPO_LAYERED_MIN_BAND
  * sampled points or the scene lies on both sides of it.
  *
- * xyz, axes: n points and unit axes (3n each); knn_sqd: n x knn_k squared
- * distances to the nearest neighbours, nearest first (the spacing).
+ * *copies (the copy rate): on the same band, if it qualifies, the share of up
+ * to DACPO_LAYERED_SAMPLE points of the surface itself (the densest slab one
+ * spacing thick in the band) that have a second parallel sheet within two
+ * spacings: stage 2's two-sheet pair test. 0 where *share is 0 for want of a
+ * band.
+ *
+ * xyz, axes: n points and unit axes (3n each); knn_idx, knn_sqd: n x knn_k
+ * nearest neighbours (self excluded, nearest first, -1 / inf padded) and their
+ * squared distances.
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_layered_share(const double* xyz,
                     const double* axes,
                     size_t n,
+                    const int32_t* knn_idx,
                     const float* knn_sqd,
                     size_t knn_k,
                     double* share,
+                    double* copies,
                     dacpo_err* err);
+/* From this copy rate on, the two-sheet rule (its pairs and c_thin) is left
+ * out as well as the side cue: copies lie on the floor everywhere, not only
+ * where a thing rests close above it. Values measured and margins:
+ * docs/DESIGN.md ("Copies or thin solids"). */
+#define DACPO_LAYERED_COPIES 0.04
 
 /* From this share of the band the scene counts as layered and the side cue
  * is left out (dacpo_pipeline.c). Measured with PCA axes: 18 shared rooms and

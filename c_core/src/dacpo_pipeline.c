@@ -1140,6 +1140,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   st->single_view_fit = 0.0;
   st->layered_share = 0.0;
+  st->layered_copies = 0.0;
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
     double fit = 0.0, slope = 0.0;
     DACPO_TRY(dacpo_single_view_fit(
@@ -1148,19 +1149,24 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
     s->p.scan_kind =
         fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
     /* Many views whose surfaces come as offset copies (fused with a
-     * registration error): the side cue would read each pair of copies as a
-     * thin solid's two faces (dacpo_layered.c), so it is left out. A kind
-     * given by the caller is taken as it is. */
-    if (s->p.scan_kind == DACPO_SCAN_MULTI_VIEW && s->p.dipole_sides > 0.0) {
+     * registration error): the thin-part rules would read each pair of copies
+     * as a thin solid's two faces (dacpo_layered.c), so they are left out. A
+     * kind given by the caller is taken as it is. */
+    if (s->p.scan_kind == DACPO_SCAN_MULTI_VIEW) {
       DACPO_TRY(dacpo_layered_share(s->cloud.xyz,
                                     s->cloud.nrm,
                                     s->cloud.n,
+                                    s->knn.idx,
                                     s->knn.sqd,
                                     s->knn.k,
                                     &st->layered_share,
+                                    &st->layered_copies,
                                     err));
-      if (st->layered_share >= DACPO_LAYERED_SHARE)
+      if (st->layered_share >= DACPO_LAYERED_SHARE ||
+          st->layered_copies >= DACPO_LAYERED_COPIES)
         s->p.dipole_sides = 0.0;
+      if (st->layered_copies >= DACPO_LAYERED_COPIES)
+        s->p.dipole_two_sheet = 0.0;
     }
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;

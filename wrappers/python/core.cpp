@@ -226,6 +226,7 @@ statsDict(const dacpo_stats* s)
   stats["scan_kind"] = s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
   stats["single_view_fit"] = s->single_view_fit;
   stats["layered_share"] = s->layered_share;
+  stats["layered_copies"] = s->layered_copies;
   stats["dipole_sides_used"] = s->dipole_sides_used;
   stats["dipole_c_used"] = s->dipole_c_used;
   stats["dipole_layers_used"] = s->dipole_layers_used;

@@ -1226,7 +1226,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu scan=%s single_view_fit=%.3f c=%g "
-               "layers=%g two_sheet=%g layered=%.3f sides=%g "
+               "layers=%g two_sheet=%g layered=%.3f copies=%.3f sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
@@ -1249,6 +1249,7 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.dipole_layers_used,
                s.dipole_two_sheet_used,
                s.layered_share,
+               s.layered_copies,
                s.dipole_sides_used,
                s.sign_flipped,
                s.sign_facing,

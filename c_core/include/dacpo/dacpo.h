@@ -437,6 +437,11 @@ typedef struct dacpo_stats {
   double dipole_sides_used;   /**< dipole_sides the run used (0 when the layered
                                    test left the side cue out, or the scan
                                    resolved to one depth view) */
+  double layered_copies;      /**< AUTO resolved to many views: on the same plane,
+                                   the share of its surface points with a second
+                                   parallel sheet within two spacings (>= 0.04:
+                                   copies all over it, the two-sheet rule is left
+                                   out too); 0 when the test did not run */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */
