@@ -170,3 +170,62 @@ TEST(DacpoLayered, PipelineLeavesTheCueOutOnFusedRooms)
   EXPECT_LE(wrong_auto, 8.0);
   EXPECT_GE(wrong_multi, 2.0 * wrong_auto);
 }
+
+namespace {
+
+// Two copies of one 1 m x 1 m plane (random samples, 2 cm mean spacing), the
+// second `gap` spacings above the first and turned by `tilt` degrees about an
+// in-plane axis (so the copies cross when gap is small); both face +z.
+// Returns % wrong after orientation from PCA axes (AUTO, seed).
+double
+orientPlaneCopies(double gap, double tilt, uint64_t seed)
+{
+  const size_t half = 2500;
+  const double h = 0.02;
+  std::vector<float> xyz, gt;
+  uint64_t st = seed * 0x9E3779B97F4A7C15ull + 1;
+  auto uniform = [&st]() {
+    st = st * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(st >> 11) / 9007199254740992.0;
+  };
+  const double a = tilt * M_PI / 180.0;
+  for (int copy = 0; copy < 2; ++copy)
+    for (size_t i = 0; i < half; ++i) {
+      const double x = uniform() - 0.5, y = uniform() - 0.5;
+      const double z = copy ? gap * h + x * std::sin(a) : 0.0;
+      const double xx = copy ? x * std::cos(a) : x;
+      xyz.insert(xyz.end(), {(float)xx, (float)y, (float)z});
+      gt.insert(gt.end(), {copy ? (float)-std::sin(a) : 0.0f, 0.0f, copy ? (float)std::cos(a) : 1.0f});
+    }
+  std::vector<float> nrm(xyz.size(), 0.0f);
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.estimate_normals = 1;
+  p.seed = seed;
+  dacpo_ctx* ctx = nullptr;
+  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+  const dacpo_status s =
+      dacpo_orient(ctx, &p, nullptr, nullptr, xyz.data(), nrm.data(), 2 * half);
+  EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
+  dacpo_ctx_free(ctx);
+  return s == DACPO_OK ? dacpo_score_oriented(gt.data(), nrm.data(), 2 * half, nullptr, nullptr)
+                       : 100.0;
+}
+
+} // namespace
+
+// Known failure (issue: copies or thin solids): two copies of a plane with
+// nothing else in the scene are read as the two faces of a thin board, which
+// is the same geometry; the copy rate needs a floor with the scene on one
+// side to tell. Measured (seed 1): 49.5-50.0 % wrong at gaps 0.3-1.5 spacings,
+// tilt 0 or 0.5 degrees. Enable when a region-level signal (copies that
+// cross, no rim) decides it.
+TEST(DacpoLayered, DISABLED_TwoCopiesOfAPlaneKeepOneOrientation)
+{
+  for (double gap : {0.3, 0.8, 1.5})
+    for (double tilt : {0.0, 0.5}) {
+      const double wrong = orientPlaneCopies(gap, tilt, 1);
+      printf("plane copies gap %.1f tilt %.1f: %.2f %% wrong\n", gap, tilt, wrong);
+      EXPECT_LE(wrong, 2.0) << "gap " << gap << " tilt " << tilt;
+    }
+}
