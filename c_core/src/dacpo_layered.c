@@ -43,8 +43,9 @@
 #include <string.h>
 
 #define LAYERED_COS 0.985 /* parallel to a main direction: within ~10 degrees */
-#define LAYERED_ORTHO 0.2 /* a later direction: |a.d| below this for the earlier ones  \
-                           */
+#define LAYERED_ORTHO                                                                  \
+  0.2 /* a later direction: |a.d| below this for the earlier ones                      \
+       */
 #define LAYERED_DIRECTIONS 3
 #define LAYERED_PROBE 4096 /* points sampled to find the band */
 #define LAYERED_CANDIDATES 256
@@ -310,6 +311,162 @@ copy_rate(const double* xyz,
   return DACPO_OK;
 }
 
+/* The spacing (median nearest-neighbour distance over a probe of the points)
+ * and the band of find_band, its probe count in *band (0: none). */
+static dacpo_status
+probe_band(const double* xyz,
+           const double* axes,
+           size_t n,
+           const float* knn_sqd,
+           size_t knn_k,
+           double* spacing,
+           double dir[3],
+           double* lo,
+           size_t* band,
+           dacpo_err* err)
+{
+  const size_t m = n < LAYERED_PROBE ? n : LAYERED_PROBE;
+  size_t* probe = dacpo_malloc_array(m, sizeof(size_t));
+  double* h = dacpo_malloc_array(m, sizeof(double));
+  if (!probe || !h) {
+    free(probe);
+    free(h);
+    return DACPO_OOM(err);
+  }
+  size_t finite = 0;
+  for (size_t t = 0; t < m; ++t) {
+    probe[t] = (size_t)((double)t * (double)n / (double)m);
+    const double d2 = (double)knn_sqd[probe[t] * knn_k];
+    if (isfinite(d2))
+      h[finite++] = sqrt(d2);
+  }
+  *spacing = finite ? dacpo_select_kth(h, finite, finite / 2) : 0.0;
+  *band = *spacing > 0.0
+              ? find_band(xyz, axes, probe, m, LAYERED_BAND * *spacing, h, dir, lo)
+              : 0;
+  free(probe);
+  free(h);
+  return DACPO_OK;
+}
+
+/* Row t of the side test's local set: sample point pick (slab index) at
+ * position t, its LAYERED_K nearest slab points copied to positions
+ * s + t LAYERED_K ..., padded with copies of itself. */
+static void
+local_rows(const dacpo_kdtree* tree,
+           const double* sxyz,
+           const double* saxes,
+           size_t pick,
+           size_t t,
+           size_t s,
+           double* lxyz,
+           double* laxes,
+           int32_t* lnb)
+{
+  int32_t idx[LAYERED_K + 1];
+  double d2[LAYERED_K + 1];
+  const size_t got = dacpo_kdtree_knn(tree, sxyz + 3 * pick, LAYERED_K + 1, idx, d2);
+  memcpy(lxyz + 3 * t, sxyz + 3 * pick, 3 * sizeof(double));
+  memcpy(laxes + 3 * t, saxes + 3 * pick, 3 * sizeof(double));
+  size_t row = 0;
+  for (size_t j = 0; j < got && row < LAYERED_K; ++j) {
+    if ((size_t)idx[j] == pick)
+      continue;
+    const size_t l = s + t * LAYERED_K + row;
+    memcpy(lxyz + 3 * l, sxyz + 3 * (size_t)idx[j], 3 * sizeof(double));
+    memcpy(laxes + 3 * l, saxes + 3 * (size_t)idx[j], 3 * sizeof(double));
+    lnb[t * LAYERED_K + row++] = (int32_t)l;
+  }
+  for (; row < LAYERED_K; ++row) {
+    const size_t l = s + t * LAYERED_K + row;
+    memcpy(lxyz + 3 * l, lxyz + 3 * t, 3 * sizeof(double));
+    memcpy(laxes + 3 * l, laxes + 3 * t, 3 * sizeof(double));
+    lnb[t * LAYERED_K + row] = (int32_t)t;
+  }
+}
+
+/* The side test (dacpo_sheet_side, LAYERED_K neighbours) on up to
+ * DACPO_LAYERED_SAMPLE of the nb_band band points, each with its neighbours
+ * among the ns points of the slab around the band: *share is the share of
+ * them where it finds a second face. */
+static dacpo_status
+side_share(const double* xyz,
+           const double* axes,
+           size_t n,
+           const double dir[3],
+           double lo,
+           double width,
+           size_t ns,
+           size_t nb_band,
+           double spacing,
+           double* share,
+           dacpo_err* err)
+{
+  const size_t s = nb_band < DACPO_LAYERED_SAMPLE ? nb_band : DACPO_LAYERED_SAMPLE;
+  const size_t nl = s * (LAYERED_K + 1);
+  double* sxyz = dacpo_malloc_array(3 * ns, sizeof(double));
+  double* saxes = dacpo_malloc_array(3 * ns, sizeof(double));
+  size_t* pick = dacpo_malloc_array(s, sizeof(size_t)); /* slab index of sample t */
+  double* lxyz = dacpo_malloc_array(3 * nl, sizeof(double));
+  double* laxes = dacpo_malloc_array(3 * nl, sizeof(double));
+  int32_t* lnb = dacpo_malloc_array(nl * LAYERED_K, sizeof(int32_t));
+  double* side = dacpo_malloc_array(nl, sizeof(double));
+  dacpo_kdtree* tree = NULL;
+  dacpo_status st =
+      sxyz && saxes && pick && lxyz && laxes && lnb && side ? DACPO_OK : DACPO_OOM(err);
+  size_t at = 0, seen = 0, taken = 0;
+  for (size_t i = 0; i < n && st == DACPO_OK; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    if (y < lo - width || y > lo + 2.0 * width)
+      continue;
+    memcpy(sxyz + 3 * at, xyz + 3 * i, 3 * sizeof(double));
+    memcpy(saxes + 3 * at, axes + 3 * i, 3 * sizeof(double));
+    if (y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS) {
+      /* every (nb_band / s)-th band point */
+      if (taken < s && seen * s >= taken * nb_band)
+        pick[taken++] = at;
+      seen++;
+    }
+    at++;
+  }
+  if (st == DACPO_OK)
+    st = dacpo_kdtree_build(sxyz, ns, &tree, err);
+  /* local set: the s sample points, then each one's neighbours (copies; their
+   * own rows point at themselves, so the test stays silent on them) */
+  for (size_t t = 0; t < s && st == DACPO_OK; ++t)
+    local_rows(tree, sxyz, saxes, pick[t], t, s, lxyz, laxes, lnb);
+  for (size_t l = s; l < s + s * LAYERED_K && st == DACPO_OK; ++l)
+    for (size_t j = 0; j < LAYERED_K; ++j)
+      lnb[l * LAYERED_K + j] = (int32_t)l;
+  if (st == DACPO_OK)
+    st = dacpo_sheet_side(lxyz,
+                          laxes,
+                          s + s * LAYERED_K,
+                          lnb,
+                          LAYERED_K,
+                          LAYERED_K,
+                          spacing,
+                          side,
+                          NULL,
+                          NULL,
+                          err);
+  if (st == DACPO_OK) {
+    size_t fired = 0;
+    for (size_t t = 0; t < s; ++t)
+      fired += side[t] != 0.0;
+    *share = (double)fired / (double)s;
+  }
+  dacpo_kdtree_free(tree);
+  free(sxyz);
+  free(saxes);
+  free(pick);
+  free(lxyz);
+  free(laxes);
+  free(lnb);
+  free(side);
+  return st;
+}
+
 dacpo_status
 dacpo_layered_share(const double* xyz,
                     const double* axes,
@@ -329,29 +486,10 @@ dacpo_layered_share(const double* xyz,
   *copies = 0.0;
   if (n <= LAYERED_K || knn_k < LAYERED_PAIRS)
     return DACPO_OK;
-  const size_t m = n < LAYERED_PROBE ? n : LAYERED_PROBE;
-  size_t* probe = dacpo_malloc_array(m, sizeof(size_t));
-  double* h = dacpo_malloc_array(m, sizeof(double));
-  if (!probe || !h) {
-    free(probe);
-    free(h);
-    return DACPO_OOM(err);
-  }
-  /* the spacing: median nearest-neighbour distance over the probe */
-  size_t finite = 0;
-  for (size_t t = 0; t < m; ++t) {
-    probe[t] = (size_t)((double)t * (double)n / (double)m);
-    const double d2 = (double)knn_sqd[probe[t] * knn_k];
-    if (isfinite(d2))
-      h[finite++] = sqrt(d2);
-  }
-  const double spacing = finite ? dacpo_select_kth(h, finite, finite / 2) : 0.0;
+  double spacing = 0.0, dir[3] = {0.0, 0.0, 0.0}, lo = 0.0;
+  size_t band = 0;
+  DACPO_TRY(probe_band(xyz, axes, n, knn_sqd, knn_k, &spacing, dir, &lo, &band, err));
   const double width = LAYERED_BAND * spacing;
-  double dir[3] = {0.0, 0.0, 0.0}, lo = 0.0;
-  const size_t band =
-      spacing > 0.0 ? find_band(xyz, axes, probe, m, width, h, dir, &lo) : 0;
-  free(probe);
-  free(h);
   if (band < DACPO_LAYERED_MIN_BAND)
     return DACPO_OK;
 
@@ -393,88 +531,5 @@ dacpo_layered_share(const double* xyz,
                         spacing,
                         copies,
                         err));
-  const size_t s = nb_band < DACPO_LAYERED_SAMPLE ? nb_band : DACPO_LAYERED_SAMPLE;
-  const size_t nl = s * (LAYERED_K + 1);
-  double* sxyz = dacpo_malloc_array(3 * ns, sizeof(double));
-  double* saxes = dacpo_malloc_array(3 * ns, sizeof(double));
-  size_t* pick = dacpo_malloc_array(s, sizeof(size_t)); /* slab index of sample t */
-  double* lxyz = dacpo_malloc_array(3 * nl, sizeof(double));
-  double* laxes = dacpo_malloc_array(3 * nl, sizeof(double));
-  int32_t* lnb = dacpo_malloc_array(nl * LAYERED_K, sizeof(int32_t));
-  double* side = dacpo_malloc_array(nl, sizeof(double));
-  int32_t idx[LAYERED_K + 1];
-  double d2[LAYERED_K + 1];
-  dacpo_kdtree* tree = NULL;
-  dacpo_status st =
-      sxyz && saxes && pick && lxyz && laxes && lnb && side ? DACPO_OK : DACPO_OOM(err);
-  size_t at = 0, seen = 0, taken = 0;
-  for (size_t i = 0; i < n && st == DACPO_OK; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y < lo - width || y > lo + 2.0 * width)
-      continue;
-    memcpy(sxyz + 3 * at, xyz + 3 * i, 3 * sizeof(double));
-    memcpy(saxes + 3 * at, axes + 3 * i, 3 * sizeof(double));
-    if (y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS) {
-      /* every (nb_band / s)-th band point */
-      if (taken < s && seen * s >= taken * nb_band)
-        pick[taken++] = at;
-      seen++;
-    }
-    at++;
-  }
-  if (st == DACPO_OK)
-    st = dacpo_kdtree_build(sxyz, ns, &tree, err);
-  /* local set: the s sample points, then each one's neighbours (copies; their
-   * own rows point at themselves, so the test stays silent on them) */
-  for (size_t t = 0; t < s && st == DACPO_OK; ++t) {
-    const size_t got =
-        dacpo_kdtree_knn(tree, sxyz + 3 * pick[t], LAYERED_K + 1, idx, d2);
-    memcpy(lxyz + 3 * t, sxyz + 3 * pick[t], 3 * sizeof(double));
-    memcpy(laxes + 3 * t, saxes + 3 * pick[t], 3 * sizeof(double));
-    size_t row = 0;
-    for (size_t j = 0; j < got && row < LAYERED_K; ++j) {
-      if ((size_t)idx[j] == pick[t])
-        continue;
-      const size_t l = s + t * LAYERED_K + row;
-      memcpy(lxyz + 3 * l, sxyz + 3 * (size_t)idx[j], 3 * sizeof(double));
-      memcpy(laxes + 3 * l, saxes + 3 * (size_t)idx[j], 3 * sizeof(double));
-      lnb[t * LAYERED_K + row++] = (int32_t)l;
-    }
-    for (; row < LAYERED_K; ++row) {
-      const size_t l = s + t * LAYERED_K + row;
-      memcpy(lxyz + 3 * l, lxyz + 3 * t, 3 * sizeof(double));
-      memcpy(laxes + 3 * l, laxes + 3 * t, 3 * sizeof(double));
-      lnb[t * LAYERED_K + row] = (int32_t)t;
-    }
-  }
-  for (size_t l = s; l < s + s * LAYERED_K && st == DACPO_OK; ++l)
-    for (size_t j = 0; j < LAYERED_K; ++j)
-      lnb[l * LAYERED_K + j] = (int32_t)l;
-  if (st == DACPO_OK)
-    st = dacpo_sheet_side(lxyz,
-                          laxes,
-                          s + s * LAYERED_K,
-                          lnb,
-                          LAYERED_K,
-                          LAYERED_K,
-                          spacing,
-                          side,
-                          NULL,
-                          NULL,
-                          err);
-  if (st == DACPO_OK) {
-    size_t fired = 0;
-    for (size_t t = 0; t < s; ++t)
-      fired += side[t] != 0.0;
-    *share = (double)fired / (double)s;
-  }
-  dacpo_kdtree_free(tree);
-  free(sxyz);
-  free(saxes);
-  free(pick);
-  free(lxyz);
-  free(laxes);
-  free(lnb);
-  free(side);
-  return st;
+  return side_share(xyz, axes, n, dir, lo, width, ns, nb_band, spacing, share, err);
 }
