@@ -39,7 +39,6 @@
 #include "dacpo_sheet_side.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -514,7 +513,6 @@ dacpo_layered_share(const double* xyz,
    * things on both sides, or nothing at all (a scan of one board). */
   const size_t beyond = below + above;
   const size_t minority = below < above ? below : above;
-  if (getenv("DACPO_DBG")) fprintf(stderr, "DBG band=%zu nb_band=%zu ns=%zu below=%zu above=%zu n=%zu dir=%.2f,%.2f,%.2f\n", band, nb_band, ns, below, above, n, dir[0], dir[1], dir[2]);
   if (nb_band < DACPO_LAYERED_MIN_BAND ||
       (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n ||
       (double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
