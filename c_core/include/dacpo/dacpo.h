@@ -113,7 +113,6 @@ typedef enum dacpo_disconnected_policy {
   DACPO_DISCONNECTED_VIEWPOINT = 3
 } dacpo_disconnected_policy;
 
-/** \brief Which of the two consistent orientations the run returns. */
 /** \brief What kind of scan the cloud is; stage 2 reads thin parts and layers
  *  differently for each. */
 typedef enum dacpo_scan_kind {
@@ -129,6 +128,7 @@ typedef enum dacpo_scan_kind {
   DACPO_SCAN_MULTI_VIEW = 2
 } dacpo_scan_kind;
 
+/** \brief Which of the two consistent orientations the run returns. */
 typedef enum dacpo_sign_policy {
   /** Normals face the free space the scene was seen from: the viewpoint
    *  that most normals face and that sees most of the scene (normals face
