@@ -285,6 +285,33 @@ two_sheet_points(const double* xyz,
   }
 }
 
+int
+dacpo_two_sheet_pair(const double p[3],
+                     const double a[3],
+                     const double q[3],
+                     const double b[3],
+                     double noise,
+                     double local,
+                     double factor,
+                     double spacing)
+{
+  const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  if (fabs(ab) < DACPO_TWO_SHEET_MIN_COS)
+    return 0;
+  const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  const double oa = fabs(r[0] * a[0] + r[1] * a[1] + r[2] * a[2]);
+  const double ob = fabs(r[0] * b[0] + r[1] * b[1] + r[2] * b[2]);
+  double tau = factor * noise;
+  if (tau < DACPO_TWO_SHEET_MIN_SPACING * spacing)
+    tau = DACPO_TWO_SHEET_MIN_SPACING * spacing;
+  const double lateral = sqrt(rr - oa * oa > 0.0 ? rr - oa * oa : 0.0);
+  const double sin_ab = sqrt(1.0 - ab * ab > 0.0 ? 1.0 - ab * ab : 0.0);
+  tau += lateral * sin_ab;
+  const double o = oa < ob ? oa : ob;
+  return tau > 0.0 && o > tau && o < DACPO_TWO_SHEET_MAX_GAP * local;
+}
+
 /* 1 if (p, axis a, point index i) and (q, axis b, index j) are two sheets. */
 static int
 two_sheet_pair(const two_sheet_scale* ts,
@@ -295,23 +322,9 @@ two_sheet_pair(const two_sheet_scale* ts,
                const double* b,
                size_t j)
 {
-  const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  if (fabs(ab) < DACPO_TWO_SHEET_MIN_COS)
-    return 0;
-  const double r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-  const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-  const double oa = fabs(r[0] * a[0] + r[1] * a[1] + r[2] * a[2]);
-  const double ob = fabs(r[0] * b[0] + r[1] * b[1] + r[2] * b[2]);
   const double noise = ts->noise[i] > ts->noise[j] ? ts->noise[i] : ts->noise[j];
-  double tau = ts->factor * noise;
-  if (tau < DACPO_TWO_SHEET_MIN_SPACING * ts->spacing)
-    tau = DACPO_TWO_SHEET_MIN_SPACING * ts->spacing;
-  const double lateral = sqrt(rr - oa * oa > 0.0 ? rr - oa * oa : 0.0);
-  const double sin_ab = sqrt(1.0 - ab * ab > 0.0 ? 1.0 - ab * ab : 0.0);
-  tau += lateral * sin_ab;
   const double local = ts->local[i] > ts->local[j] ? ts->local[i] : ts->local[j];
-  const double o = oa < ob ? oa : ob;
-  return tau > 0.0 && o > tau && o < DACPO_TWO_SHEET_MAX_GAP * local;
+  return dacpo_two_sheet_pair(p, a, q, b, noise, local, ts->factor, ts->spacing);
 }
 
 /* Surfaces seen from one side (a single depth frame, a registered scan without
@@ -1015,6 +1028,41 @@ dipole_check(size_t n, const dacpo_dipole_params* params, dacpo_err* err)
   return DACPO_OK;
 }
 
+/* The order and vote buffers of M orders and R restarts. */
+static dacpo_status
+dipole_alloc(dipole_work* wk, size_t n, size_t M, size_t R, dacpo_err* err)
+{
+  wk->sign = dacpo_malloc_array(M * n, sizeof(int8_t));
+  wk->visited = dacpo_malloc_array(n, sizeof(uint8_t));
+  wk->queue = dacpo_malloc_array(n, sizeof(int32_t));
+  wk->order0 = dacpo_malloc_array(n, sizeof(int32_t));
+  wk->perm = dacpo_malloc_array(n, sizeof(int32_t));
+  wk->cand = dacpo_malloc_array(n * R, sizeof(int8_t));
+  if (!wk->sign || !wk->visited || !wk->queue || !wk->order0 || !wk->perm || !wk->cand)
+    return DACPO_OOM(err);
+  return DACPO_OK;
+}
+
+/* params->thin_out / cue_out (when given): where the point side cue fired
+ * (not the patch test), and whether it agrees with the returned sign. */
+static void
+cue_outputs(const dipole_work* wk,
+            size_t n,
+            const dacpo_dipole_params* params,
+            const int8_t* sign_out)
+{
+  if (params->thin_out)
+    for (size_t i = 0; i < n; ++i)
+      params->thin_out[i] =
+          wk->unary && wk->unary[i] != 0.0 && (!wk->patch || wk->patch[i] == 0.0);
+  if (params->cue_out)
+    for (size_t i = 0; i < n; ++i)
+      params->cue_out[i] =
+          !wk->unary || wk->unary[i] == 0.0 || (wk->patch && wk->patch[i] != 0.0) ? 0
+          : (wk->unary[i] > 0.0) == (sign_out[i] > 0)                             ? 1
+                                                                                  : -1;
+}
+
 dacpo_status
 dacpo_dipole_orient_confidence(const double* xyz,
                                const double* nrm,
@@ -1052,17 +1100,8 @@ dacpo_dipole_orient_confidence(const double* xyz,
   dacpo_status st = dipole_neighbors(xyz, nrm, n, K, params, &wk, err);
   if (st == DACPO_OK)
     st = dipole_graph(n, K, gk, &wk, err);
-  if (st == DACPO_OK) {
-    wk.sign = dacpo_malloc_array(M * n, sizeof(int8_t));
-    wk.visited = dacpo_malloc_array(n, sizeof(uint8_t));
-    wk.queue = dacpo_malloc_array(n, sizeof(int32_t));
-    wk.order0 = dacpo_malloc_array(n, sizeof(int32_t));
-    wk.perm = dacpo_malloc_array(n, sizeof(int32_t));
-    wk.cand = dacpo_malloc_array(n * (params->restarts ? params->restarts : 1),
-                                 sizeof(int8_t));
-    if (!wk.sign || !wk.visited || !wk.queue || !wk.order0 || !wk.perm || !wk.cand)
-      st = DACPO_OOM(err);
-  }
+  if (st == DACPO_OK)
+    st = dipole_alloc(&wk, n, M, params->restarts ? params->restarts : 1, err);
   if (st != DACPO_OK) {
     dipole_work_free(&wk);
     return st;
@@ -1088,16 +1127,7 @@ dacpo_dipole_orient_confidence(const double* xyz,
     dipole_vote(&wk, n, K, R, params->final_sweep, sign_out);
   else
     memcpy(sign_out, wk.cand + best * n, n);
-  if (params->thin_out)
-    for (size_t i = 0; i < n; ++i)
-      params->thin_out[i] =
-          wk.unary && wk.unary[i] != 0.0 && (!wk.patch || wk.patch[i] == 0.0);
-  if (params->cue_out)
-    for (size_t i = 0; i < n; ++i)
-      params->cue_out[i] =
-          !wk.unary || wk.unary[i] == 0.0 || (wk.patch && wk.patch[i] != 0.0) ? 0
-          : (wk.unary[i] > 0.0) == (sign_out[i] > 0)                          ? 1
-                                                                              : -1;
+  cue_outputs(&wk, n, params, sign_out);
   if (confidence)
     dipole_confidence(&wk, n, K, R, sign_out, confidence);
   dipole_work_free(&wk);

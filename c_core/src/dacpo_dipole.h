@@ -48,6 +48,22 @@ typedef struct dacpo_dipole_params {
                         where it disagrees, 0 elsewhere */
 } dacpo_dipole_params;
 
+/* Stage 2's two-sheet pair test: 1 if (p, axis a) and (q, axis b) lie on two
+ * sheets of one thin part (or two copies of one surface): axes within ~37
+ * degrees, each point off the other's tangent plane by more than
+ * max(factor x noise, 0.5 x spacing) plus the bend of one curved sheet, and by
+ * less than 2 x local. noise, local: the larger local noise scale and local
+ * spacing of the two points; spacing: the block's (or scene's) typical
+ * nearest-neighbour distance. */
+int
+dacpo_two_sheet_pair(const double p[3],
+                     const double a[3],
+                     const double q[3],
+                     const double b[3],
+                     double noise,
+                     double local,
+                     double factor,
+                     double spacing);
 /* e((p,n),(p',n')) = F_{p,n}(p') . n' with F of Eq. 1. Exposed for tests and for
  * the dipole-boundary edge weight. Returns 0 for |r| below 1e-12 relative. */
 double

@@ -35,6 +35,7 @@
  */
 #include "dacpo_layered.h"
 
+#include "dacpo_dipole.h"
 #include "dacpo_kdtree.h"
 #include "dacpo_sheet_side.h"
 
@@ -43,20 +44,16 @@
 #include <string.h>
 
 #define LAYERED_COS 0.985 /* parallel to a main direction: within ~10 degrees */
-#define LAYERED_ORTHO                                                                  \
-  0.2 /* a later direction: |a.d| below this for the earlier ones                      \
-       */
+/* a later direction: |a.d| below this for the earlier ones */
+#define LAYERED_ORTHO 0.2
 #define LAYERED_DIRECTIONS 3
 #define LAYERED_PROBE 4096 /* points sampled to find the band */
 #define LAYERED_CANDIDATES 256
 #define LAYERED_BAND 3.0 /* band thickness, spacings */
 #define LAYERED_K 32     /* neighbours of the side test (as stage 2 on many views) */
 
-#define LAYERED_NOISE_K 16 /* neighbours of the local noise scale (as stage 2) */
-#define LAYERED_PAIR_COS 0.8
-#define LAYERED_PAIR_NOISE 3.0
-#define LAYERED_PAIR_MIN 0.5 /* x spacing */
-#define LAYERED_PAIR_MAX 2.0 /* x local spacing */
+#define LAYERED_NOISE_K 16     /* neighbours of the local noise scale (as stage 2) */
+#define LAYERED_PAIR_NOISE 3.0 /* stage 2's default two-sheet factor */
 #define LAYERED_PAIRS 3
 
 static double
@@ -120,21 +117,16 @@ has_second_sheet(const double* xyz,
     if (idx[i * k + t] < 0)
       continue;
     const size_t j = (size_t)idx[i * k + t];
-    const double* b = axes + 3 * j;
-    const double ab = dot3(a, b);
-    if (j == i || fabs(ab) < LAYERED_PAIR_COS)
+    if (j == i)
       continue;
-    const double oa = fabs(offset(p, a, xyz + 3 * j));
-    const double ob = fabs(offset(p, b, xyz + 3 * j));
-    const double o = oa < ob ? oa : ob;
-    const double noise = fmax(noise_i, local_noise(xyz, axes, idx, k, j));
-    const double rr =
-        dot3(xyz + 3 * j, xyz + 3 * j) - 2.0 * dot3(p, xyz + 3 * j) + dot3(p, p);
-    const double lateral = sqrt(fmax(rr - oa * oa, 0.0));
-    const double tau = fmax(LAYERED_PAIR_NOISE * noise, LAYERED_PAIR_MIN * spacing) +
-                       lateral * sqrt(fmax(1.0 - ab * ab, 0.0));
-    const double local = fmax(local_i, local_spacing(sqd, k, j));
-    pairs += o > tau && o < LAYERED_PAIR_MAX * local;
+    pairs += dacpo_two_sheet_pair(p,
+                                  a,
+                                  xyz + 3 * j,
+                                  axes + 3 * j,
+                                  fmax(noise_i, local_noise(xyz, axes, idx, k, j)),
+                                  fmax(local_i, local_spacing(sqd, k, j)),
+                                  LAYERED_PAIR_NOISE,
+                                  spacing);
   }
   return pairs >= LAYERED_PAIRS;
 }
@@ -234,17 +226,8 @@ spans_scene(const double* xyz,
             double lo,
             double width)
 {
-  const double h[3] = {
-      fabs(dir[0]) < 0.9 ? 1.0 : 0.0, fabs(dir[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-  double e1[3] = {dir[1] * h[2] - dir[2] * h[1],
-                  dir[2] * h[0] - dir[0] * h[2],
-                  dir[0] * h[1] - dir[1] * h[0]};
-  const double l = sqrt(dot3(e1, e1));
-  for (int d = 0; d < 3; ++d)
-    e1[d] /= l;
-  const double e2[3] = {dir[1] * e1[2] - dir[2] * e1[1],
-                        dir[2] * e1[0] - dir[0] * e1[2],
-                        dir[0] * e1[1] - dir[1] * e1[0]};
+  double e1[3], e2[3];
+  dacpo_tangent_frame(dir, e1, e2);
   double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY, depth = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const double* p = xyz + 3 * i;

@@ -63,9 +63,8 @@
 #define SIDE_SEP_FULL 8.0
 #define SIDE_FIT_ROUNDS 3
 
-/* An orthonormal tangent pair (e1, e2) for unit axis a. */
-static void
-tangent_frame(const double a[3], double e1[3], double e2[3])
+void
+dacpo_tangent_frame(const double a[3], double e1[3], double e2[3])
 {
   const double h[3] = {fabs(a[0]) < 0.9 ? 1.0 : 0.0, fabs(a[0]) < 0.9 ? 0.0 : 1.0, 0.0};
   e1[0] = a[1] * h[2] - a[2] * h[1];
@@ -383,7 +382,7 @@ point_side(const double* xyz,
   const double* p = xyz + 3 * i;
   const double* a = nrm + 3 * i;
   double e1[3], e2[3];
-  tangent_frame(a, e1, e2);
+  dacpo_tangent_frame(a, e1, e2);
   double u[DACPO_SIDE_MAX_NEIGHBORS + 1], v[DACPO_SIDE_MAX_NEIGHBORS + 1],
       z[DACPO_SIDE_MAX_NEIGHBORS + 1];
   double l[DACPO_SIDE_MAX_NEIGHBORS + 1];
@@ -494,8 +493,8 @@ dacpo_sheet_side(const double* xyz,
 #define PATCH_MIN_GAP 0.25 /* x spacing: below, a clean sheet's fit residue */
 #define PATCH_MAX_GAP 1.5  /* x spacing: beyond, the two-sheet rule (and air gaps) */
 #define PATCH_MIN_CLUSTER 0.2
-#define PATCH_MIN_MIXED 0.3 /* graph pairs across the faces: a board interleaves them  \
-                             */
+/* graph pairs across the faces: a board interleaves them */
+#define PATCH_MIN_MIXED 0.3
 #define PATCH_MIN_NOISE 0.025 /* x spacing: clean data is left to the point test */
 /* Two faces leave a dip at the mid-surface: few points lie within a quarter
  * gap of it (two Gaussian copies at the least separation 3.6: 18 %; measured
@@ -561,7 +560,7 @@ patch_two_faces(const double* xyz,
                 double* sharp)
 {
   double e1[3], e2[3], c0[3] = {0.0, 0.0, 0.0}, c[7];
-  tangent_frame(a, e1, e2);
+  dacpo_tangent_frame(a, e1, e2);
   for (size_t k = 0; k < m; ++k)
     for (int d = 0; d < 3; ++d)
       c0[d] += xyz[3 * (size_t)mem[k] + d] / (double)m;
@@ -615,6 +614,92 @@ patch_two_faces(const double* xyz,
   return conf < 1.0 ? conf : 1.0;
 }
 
+/* A board interleaves its faces: many graph pairs inside the patch (the m
+ * members mem of patch pid) cross them; the members' face labels are the
+ * signs of lab. */
+static int
+patch_is_board(const int32_t* nb,
+               size_t K,
+               const int32_t* pid,
+               const int32_t* mem,
+               size_t m,
+               const double* lab)
+{
+  size_t pairs = 0, across = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = (size_t)mem[k];
+    for (size_t t = 0; t < K && t < PATCH_GROW_K; ++t) {
+      const size_t j = (size_t)nb[i * K + t];
+      if (j == i || pid[j] != pid[i])
+        continue;
+      ++pairs;
+      across += (lab[j] > 0.0) != (lab[i] > 0.0);
+    }
+  }
+  return pairs > 0 && (double)across >= PATCH_MIN_MIXED * (double)pairs;
+}
+
+/* The face rows of a board patch's members whose own cue is silent: +1 for a
+ * neighbour on the same face (same sign of lab), -1 on the other, 0 outside
+ * the patch. */
+static void
+patch_face_rows(const int32_t* nb,
+                size_t K,
+                const int32_t* pid,
+                const int32_t* mem,
+                size_t m,
+                const double* side,
+                const double* lab,
+                int8_t* face)
+{
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = (size_t)mem[k];
+    if (side[i] != 0.0)
+      continue;
+    int8_t* row = face + i * K;
+    for (size_t t = 0; t < K; ++t) {
+      const size_t j = (size_t)nb[i * K + t];
+      row[t] = (j == i || pid[j] != pid[i])
+                   ? 0
+                   : ((lab[j] > 0.0) == (lab[i] > 0.0) ? 1 : -1);
+    }
+  }
+}
+
+/* conf (and field) of the m members of one patch: signed as side[] (the face
+ * looks away from the other copy, the label l[k] along axis a), pc x the
+ * distance from the mid-surface r[k] (capped at 1), where the patch is a board
+ * and the point's own cue is silent (field: the patch's clearness sharp); 0
+ * elsewhere. Returns how many got a conf. */
+static size_t
+patch_conf(const double* nrm,
+           const int32_t* mem,
+           size_t m,
+           const double* a,
+           const double* l,
+           const double* r,
+           double pc,
+           int board,
+           double sharp,
+           const double* side,
+           double* conf,
+           double* field)
+{
+  size_t count = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = (size_t)mem[k];
+    const double near = r[k] < 1.0 ? r[k] : 1.0; /* near the mid-surface: unsure */
+    const double* b = nrm + 3 * i;
+    const double look =
+        (l[k] > 0.0) == (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > 0.0) ? 1.0 : -1.0;
+    conf[i] = (board && side[i] == 0.0) ? look * pc * near : 0.0;
+    if (field)
+      field[i] = conf[i] != 0.0 ? sharp : 0.0;
+    count += conf[i] != 0.0;
+  }
+  return count;
+}
+
 dacpo_status
 dacpo_sheet_patches(const double* xyz,
                     const double* nrm,
@@ -643,11 +728,8 @@ dacpo_sheet_patches(const double* xyz,
   memset(conf, 0, n * sizeof(double));
   if (field)
     memset(field, 0, n * sizeof(double));
-  if (!(spacing > 0.0)) {
-    if (fired)
-      *fired = 0;
+  if (!(spacing > 0.0))
     return DACPO_OK;
-  }
   int32_t* pid = dacpo_malloc_array(n, sizeof(int32_t));
   int32_t* mem = dacpo_malloc_array(PATCH_MAX_POINTS, sizeof(int32_t));
   double* buf = dacpo_malloc_array(5 * PATCH_MAX_POINTS, sizeof(double));
@@ -681,47 +763,14 @@ dacpo_sheet_patches(const double* xyz,
     const double pc = patch_two_faces(xyz, a, mem, m, spacing, u, v, z, l, r, &sharp);
     if (!(pc > 0.0))
       continue;
-    /* a board interleaves its faces: many graph pairs cross them. The
-     * members' labels are kept in conf's sign while counting (conf is
-     * rewritten for these points right after). */
+    /* The members' labels are kept in conf's sign while the board test and
+     * the face rows read them (conf is rewritten for these points after). */
     for (size_t k = 0; k < m; ++k)
       conf[mem[k]] = l[k];
-    size_t pairs = 0, across = 0;
-    for (size_t k = 0; k < m; ++k) {
-      const size_t i = (size_t)mem[k];
-      for (size_t t = 0; t < K && t < PATCH_GROW_K; ++t) {
-        const size_t j = (size_t)nb[i * K + t];
-        if (j == i || pid[j] != pid[i])
-          continue;
-        ++pairs;
-        across += (conf[j] > 0.0) != (conf[i] > 0.0);
-      }
-    }
-    const int board = pairs > 0 && (double)across >= PATCH_MIN_MIXED * (double)pairs;
-    for (size_t k = 0; k < m; ++k) {
-      const size_t i = (size_t)mem[k];
-      if (!board || side[i] != 0.0)
-        continue;
-      int8_t* row = face + i * K;
-      for (size_t t = 0; t < K; ++t) {
-        const size_t j = (size_t)nb[i * K + t];
-        row[t] = (j == i || pid[j] != pid[i])
-                     ? 0
-                     : ((conf[j] > 0.0) == (conf[i] > 0.0) ? 1 : -1);
-      }
-    }
-    for (size_t k = 0; k < m; ++k) {
-      const size_t i = (size_t)mem[k];
-      const double near = r[k] < 1.0 ? r[k] : 1.0; /* near the mid-surface: unsure */
-      /* signed as side[]: the face looks away from the other copy */
-      const double* b = nrm + 3 * i;
-      const double look =
-          (l[k] > 0.0) == (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > 0.0) ? 1.0 : -1.0;
-      conf[i] = (board && side[i] == 0.0) ? look * pc * near : 0.0;
-      if (field)
-        field[i] = conf[i] != 0.0 ? sharp : 0.0;
-      count += conf[i] != 0.0;
-    }
+    const int board = patch_is_board(nb, K, pid, mem, m, conf);
+    if (board)
+      patch_face_rows(nb, K, pid, mem, m, side, conf, face);
+    count += patch_conf(nrm, mem, m, a, l, r, pc, board, sharp, side, conf, field);
   }
   free(pid);
   free(mem);

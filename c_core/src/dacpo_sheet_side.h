@@ -24,6 +24,10 @@
  * single depth frame's block.
  *
  * Failures: none beyond INVALID_ARGUMENT for NULL arrays (pure arithmetic). */
+/* An orthonormal tangent pair (e1, e2) for unit axis a. */
+void
+dacpo_tangent_frame(const double a[3], double e1[3], double e2[3]);
+
 #define SIDE_HIDDEN (-2)
 #define DACPO_SIDE_MAX_NEIGHBORS 32
 

@@ -1174,49 +1174,10 @@ orientTiled(const std::string& in, const std::string& out, const Options& option
   return 0;
 }
 
-/* One input to one output (and the side outputs), then the stats line;
- * 0 on success, 1 on failure (the message is printed). */
-int
-orientFile(const std::string& in, const std::string& out, const Options& options)
+/* One machine-readable line, printed even with -q (benchmarks grep it). */
+void
+printStats(const Result& result)
 {
-  if (options.memory > 0.0 || options.tile_points > 0) {
-    const int tiled = orientTiled(in, out, options);
-    if (tiled != kFitsInCore)
-      return tiled;
-  }
-  pcl::PCLPointCloud2 cloud;
-  if (!loadCloud(in, cloud))
-    return 1;
-  if (cloud.width * cloud.height == 0) {
-    print_error("Error: '%s' has no points\n", in.c_str());
-    return 1;
-  }
-  pcl::PCLPointCloud2 output;
-  Result result;
-  if (!compute(cloud, options, output, result))
-    return 1;
-  if (!options.mesh.empty() && result.mesh_triangles.empty()) {
-    print_error(
-        "Error: no surface mesh for '%s': its %zu points are too few or too sparse "
-        "for a Poisson surface (blocks need at least 32 points); nothing written\n",
-        in.c_str(),
-        result.points);
-    return 1;
-  }
-  if (!saveCloud(out, output))
-    return 1;
-  if (!options.edges.empty() && !saveEdges(options.edges, result))
-    return 1;
-  if (!options.blocks_colored.empty() &&
-      !saveBlocksColored(options.blocks_colored, cloud, result))
-    return 1;
-  if (!options.mesh.empty() && !saveMesh(options.mesh, result))
-    return 1;
-  if (!options.normals_colored.empty() &&
-      !saveCloud(options.normals_colored, dacpo_tool::normalsColored(output)))
-    return 1;
-
-  /* One machine-readable line, printed even with -q (benchmarks grep it). */
   const dacpo_stats& s = result.stats;
   const std::size_t low = static_cast<std::size_t>(std::count_if(
       result.edges.begin(), result.edges.end(), [](const dacpo_edge_info& e) {
@@ -1261,6 +1222,51 @@ orientFile(const std::string& in, const std::string& out, const Options& options
                s.ipsr_iterations_max,
                s.total_seconds,
                peakRssMb());
+}
+
+/* One input to one output (and the side outputs), then the stats line;
+ * 0 on success, 1 on failure (the message is printed). */
+int
+orientFile(const std::string& in, const std::string& out, const Options& options)
+{
+  if (options.memory > 0.0 || options.tile_points > 0) {
+    const int tiled = orientTiled(in, out, options);
+    if (tiled != kFitsInCore)
+      return tiled;
+  }
+  pcl::PCLPointCloud2 cloud;
+  if (!loadCloud(in, cloud))
+    return 1;
+  if (cloud.width * cloud.height == 0) {
+    print_error("Error: '%s' has no points\n", in.c_str());
+    return 1;
+  }
+  pcl::PCLPointCloud2 output;
+  Result result;
+  if (!compute(cloud, options, output, result))
+    return 1;
+  if (!options.mesh.empty() && result.mesh_triangles.empty()) {
+    print_error(
+        "Error: no surface mesh for '%s': its %zu points are too few or too sparse "
+        "for a Poisson surface (blocks need at least 32 points); nothing written\n",
+        in.c_str(),
+        result.points);
+    return 1;
+  }
+  if (!saveCloud(out, output))
+    return 1;
+  if (!options.edges.empty() && !saveEdges(options.edges, result))
+    return 1;
+  if (!options.blocks_colored.empty() &&
+      !saveBlocksColored(options.blocks_colored, cloud, result))
+    return 1;
+  if (!options.mesh.empty() && !saveMesh(options.mesh, result))
+    return 1;
+  if (!options.normals_colored.empty() &&
+      !saveCloud(options.normals_colored, dacpo_tool::normalsColored(output)))
+    return 1;
+
+  printStats(result);
   return 0;
 }
 
