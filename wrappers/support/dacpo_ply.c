@@ -696,6 +696,8 @@ skip_elements_before(ply_in* in,
 {
   for (const ply_element* e = h->el; e != vert; ++e) {
     double dummy[6];
+    if (e->nprops == 0) /* its rows hold nothing, however many it declares */
+      continue;
     const uint64_t left = (uint64_t)fsize - in->consumed;
     const uint64_t row = min_row_bytes(h->format, e);
     if (row > 0 && e->count > left / row) {

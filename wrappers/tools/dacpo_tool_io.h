@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <exception>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -740,17 +741,25 @@ loadCloud2(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& err
   if ((ext == ".pcd" || ext == ".ply") &&
       !checkCloudFile(path, static_cast<long long>(st.st_size), error))
     return false;
-  int rc = -1;
-  if (ext == ".pcd") {
-    pcl::PCDReader reader;
-    rc = reader.read(path, cloud);
-  }
-  else if (ext == ".ply") {
-    pcl::PLYReader reader;
-    rc = reader.read(path, cloud);
-  }
-  else {
+  if (ext != ".pcd" && ext != ".ply") {
     error = "'" + path + "': unknown extension (use .pcd or .ply)";
+    return false;
+  }
+  int rc = -1;
+  /* PCL's readers throw on some headers the checks above let through (a
+   * field name with bytes that split it in two: std::out_of_range). */
+  try {
+    if (ext == ".pcd") {
+      pcl::PCDReader reader;
+      rc = reader.read(path, cloud);
+    }
+    else {
+      pcl::PLYReader reader;
+      rc = reader.read(path, cloud);
+    }
+  }
+  catch (const std::exception& e) {
+    error = "cannot read '" + path + "': " + e.what();
     return false;
   }
   if (rc < 0) {
