@@ -71,3 +71,29 @@ o=$(run 2 "$W/b.ply" "$W/x.pcd" -tiles 12000 2>&1); st=$?
 set -e
 [ ! -e "$W/x.ply" ] && [ ! -e "$W/x.pcd" ] || fail "a failed mpi run left an output file"
 echo "tiles: 1, 2 and 3 ranks write the bytes of one process; held points per rank: $(echo $held)"
+
+# a full disk: a 2 MB tmpfs with 1.7 MB of filler and an old output on it;
+# every writer fails with a message, keeps the old output and leaves no
+# temporary file (needs root for the mount; skipped with a note otherwise)
+full_disk() { # label, command...
+  local label=$1; shift
+  mkdir -p "$W/full"
+  mount -t tmpfs -o size=2m tmpfs "$W/full" 2>/dev/null || return 1
+  head -c 1700000 /dev/zero > "$W/full/filler"; echo old > "$W/full/o.ply"
+  set +e; o=$("$@" 2>&1); st=$?; set -e
+  local left; left=$(ls -A "$W/full" | tr '\n' ' '); local kept; kept=$(cat "$W/full/o.ply")
+  umount "$W/full"
+  [ $st -ne 0 ] || fail "$label on a full disk: exit 0: $o"
+  grep -q "disk full\|No space left" <<< "$o" || fail "$label on a full disk: no message: $o"
+  [ "$kept" = old ] || fail "$label on a full disk: the old output was replaced"
+  [ "$left" = "filler o.ply " ] || fail "$label on a full disk: left $left"
+}
+"$MAKE" "$W/r20.ply" -scene room -n 20000 -seed 4 > /dev/null
+if full_disk "mpi -tiles" run 2 "$W/r20.ply" "$W/full/o.ply" -tiles 5000 -q; then
+  full_disk "mpi in core" run 2 "$W/r20.ply" "$W/full/o.ply" -q
+  full_disk "-tiles" "$ORIENT" "$W/r20.ply" "$W/full/o.ply" -tiles 5000 -q
+  full_disk "in core" "$ORIENT" "$W/r20.ply" "$W/full/o.ply" -q
+  echo "tiles: a full disk fails with a message and keeps the old output (mpi tiles and in core, tool tiles and in core)"
+else
+  echo "tiles: full-disk checks skipped (cannot mount a tmpfs here: not root?)"
+fi

@@ -513,6 +513,21 @@ orient_and_join(tiles_run* t,
 }
 
 /* write: own normals to their range's rank; each rank writes its range. */
+/* one MPI_File_write_at whose byte count is checked: a short write (a full
+   disk, a file size limit) is an error, not a hole in the output */
+static int
+write_all_at(MPI_File fh, MPI_Offset at, const void* buf, size_t bytes, char* err, size_t cap)
+{
+  MPI_Status st;
+  int count = -1;
+  if (MPI_File_write_at(fh, at, buf, (int)bytes, MPI_BYTE, &st) != MPI_SUCCESS ||
+      MPI_Get_count(&st, MPI_BYTE, &count) != MPI_SUCCESS || count != (int)bytes) {
+    snprintf(err, cap, "(%d of %zu bytes written: disk full?)", count < 0 ? 0 : count, bytes);
+    return 0;
+  }
+  return 1;
+}
+
 static int
 write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tiles_report* rep)
 {
@@ -565,11 +580,17 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
       fprintf(stderr, "Error: cannot create '%s'\n", tmp);
     return 0;
   }
-  MPI_File_set_size(fh, (MPI_Offset)hlen + (MPI_Offset)(t->n * DACPO_TILED_OUT_BYTES));
-  if (t->rank == 0)
-    ok = MPI_File_write_at(fh, 0, header, hlen, MPI_BYTE, MPI_STATUS_IGNORE) == MPI_SUCCESS;
-  float* rec = malloc((size_t)ROUND_POINTS * DACPO_TILED_OUT_BYTES);
+  /* the whole size is allocated on disk first (not a sparse set_size): a full
+     disk fails here, before any row, and every write's count is checked */
+  const MPI_Offset total = (MPI_Offset)hlen + (MPI_Offset)(t->n * DACPO_TILED_OUT_BYTES);
   char err[512] = "";
+  ok = MPI_File_preallocate(fh, total) == MPI_SUCCESS;
+  if (!ok)
+    snprintf(err, sizeof(err), "(no room for %lld bytes: disk full?)", (long long)total);
+  ok = dacpo_mpi_all_ok(ok);
+  if (ok && t->rank == 0)
+    ok = write_all_at(fh, 0, header, (size_t)hlen, err, sizeof(err));
+  float* rec = malloc((size_t)ROUND_POINTS * DACPO_TILED_OUT_BYTES);
   ok = ok && rec != NULL;
   for (uint64_t first = t->lo; ok && first < t->hi; first += ROUND_POINTS) {
     const size_t take = (size_t)(t->hi - first < ROUND_POINTS ? t->hi - first : ROUND_POINTS);
@@ -578,17 +599,19 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
       memcpy(rec + 6 * i, t->chunk + 3 * i, 12);
       memcpy(rec + 6 * i + 3, t->range_nrm + 3 * (first - t->lo + i), 12);
     }
-    ok = ok && MPI_File_write_at(fh,
-                                 (MPI_Offset)hlen + (MPI_Offset)(first * DACPO_TILED_OUT_BYTES),
-                                 rec,
-                                 (int)(take * DACPO_TILED_OUT_BYTES),
-                                 MPI_BYTE,
-                                 MPI_STATUS_IGNORE) == MPI_SUCCESS;
+    ok = ok && write_all_at(fh,
+                            (MPI_Offset)hlen + (MPI_Offset)(first * DACPO_TILED_OUT_BYTES),
+                            rec,
+                            take * DACPO_TILED_OUT_BYTES,
+                            err,
+                            sizeof(err));
   }
   free(rec);
+  /* sync and close are collective: every rank calls them, failed or not */
+  ok = MPI_File_sync(fh) == MPI_SUCCESS && ok;
+  ok = MPI_File_close(&fh) == MPI_SUCCESS && ok;
   if (!ok)
     fprintf(stderr, "Error (rank %d): writing '%s' failed %s\n", t->rank, tmp, err);
-  MPI_File_close(&fh);
   ok = dacpo_mpi_all_ok(ok);
   if (t->rank == 0) {
     if (ok && rename(tmp, path) != 0) {
