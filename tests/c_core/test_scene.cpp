@@ -792,6 +792,12 @@ TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
       "property float z\nend_header\n1 2 abc\n",                     // bad ascii value
       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", // no end_header
       "ply\nformat ascii 1.0\nbogus line\nend_header\n",
+      // an ASCII row is one line: one value too many or too few shifts every
+      // later point unless the line end is checked
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n1 0 0 7\n0 1 0\n",
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0\n1 0 0\n0 1 0\n",
   };
   for (const char* h : bad_headers) {
     WriteBytes(path, h, std::strlen(h));

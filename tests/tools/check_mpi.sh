@@ -101,7 +101,22 @@ set -e
 set +e
 out=$(run 2 "$W/room.ply" "$W/no_such_dir/x.ply" -q 2>&1); st=$?
 set -e
-[ "$st" -ne 0 ] && grep -q "cannot open" <<< "$out" || fail "unwritable output: status $st: $out"
+[ "$st" -ne 0 ] && grep -q "does not exist" <<< "$out" || fail "unwritable output: status $st: $out"
+set +e
+out=$(run 2 "$W/room.ply" "$W/x.ply" -q -report "$W/no_such_dir/r.json" 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "does not exist" <<< "$out" || fail "-report into a missing folder: status $st: $out"
+set +e
+out=$(run 2 "$W/room.ply" "$W/x.txt" -q 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q ".ply or .pcd" <<< "$out" || fail "output o.txt: status $st: $out"
+[ ! -e "$W/x.txt" ] || fail "a .txt output was written"
+# an ASCII row with one value too many: refused, not every later point shifted
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0 7\n0 1 0\n' > "$W/extra.ply"
+set +e
+out=$(run 2 "$W/extra.ply" "$W/x.ply" -q 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "more or fewer values" <<< "$out" || fail "ASCII row with an extra value: status $st: $out"
 # help: every option named, status 0
 out=$(run 2 -h)
 for opt in -estimate -seed -blocks -k -normal_k -threads -whole -spread_knn -knn_halo \

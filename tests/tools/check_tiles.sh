@@ -46,9 +46,17 @@ o=$("$ORIENT" "$W/b.ply" "$W/x.ply" -tiles 12000 -labels 2>&1); st=$?
 [ $st -ne 0 ] && grep -q "without -labels" <<< "$o" || fail "-labels with tiles: status $st: $o"
 o=$("$ORIENT" "$W/b.ply" "$W/x.ply" -memory 10M 2>&1); st=$?
 [ $st -ne 0 ] && grep -q "needs at least" <<< "$o" || fail "-memory 10M: status $st: $o"
+# an output name too long for a temporary sibling fails before any work, and
+# an old file of that name is kept
+long="$W/$(printf 'a%.0s' $(seq 1 250)).ply"
+echo old > "$long"
+o=$("$ORIENT" "$W/b.ply" "$long" -tiles 12000 2>&1); st=$?
+[ $st -ne 0 ] && grep -q "name too long" <<< "$o" && [ "$(cat "$long")" = old ] ||
+  fail "a name too long for a temp file: status $st: $o"
+rm -f "$long"
 set -e
 [ ! -e "$W/x.ply" ] && [ ! -e "$W/x.pcd" ] || fail "a failed run left an output file"
-echo "tiles: fits-in-core answer, NaN, ASCII, .pcd, -labels and too small a budget checked"
+echo "tiles: fits-in-core answer, NaN, ASCII, .pcd, -labels, too small a budget and too long a name checked"
 
 [ -n "$MPI_TOOL" ] || exit 0
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1

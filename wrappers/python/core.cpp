@@ -70,11 +70,21 @@ defaultParams()
   return d;
 }
 
+/* A keyword's value as T; a value T cannot hold (k=2**70, seed=-1, k="x")
+ * is a ValueError naming the keyword, not pybind11's "Unable to cast". */
 template <typename T>
 T
 get(const py::dict& d, const char* name, T fallback)
 {
-  return d.contains(name) ? d[name].cast<T>() : fallback;
+  if (!d.contains(name))
+    return fallback;
+  try {
+    return d[name].cast<T>();
+  }
+  catch (const py::cast_error&) {
+    throw py::value_error(std::string(name) + "=" + py::repr(d[name]).cast<std::string>() +
+                          ": not a value this keyword can take (see help(pcl_dacpo.orient))");
+  }
 }
 
 dacpo_params

@@ -147,6 +147,7 @@ typedef struct ply_in {
   size_t pos, len;
   size_t consumed; /* bytes handed out so far (header included) */
   int eof;
+  int eol; /* ASCII: the last token ended its line */
 } ply_in;
 
 static int
@@ -229,14 +230,20 @@ in_line(ply_in* in, char* line, size_t cap)
   return 0;
 }
 
-/* Next whitespace-separated ASCII token; -1 at end of file, -2 when too long. */
+/* Next whitespace-separated ASCII token; -1 at end of file, -2 when too long,
+ * -3 when the line ended and !first (an ASCII row is one line: a token may
+ * not come from the next line, or every later point would shift). */
 static int
-in_token(ply_in* in, char* tok, size_t cap)
+in_token(ply_in* in, char* tok, size_t cap, int first)
 {
   size_t k = 0;
   int c;
+  if (in->eol && !first)
+    return -3;
   do {
     c = in_getc(in);
+    if (c == '\n' && !first)
+      return -3;
   } while (c == ' ' || c == '\t' || c == '\n' || c == '\r');
   if (c < 0)
     return -1;
@@ -246,7 +253,21 @@ in_token(ply_in* in, char* tok, size_t cap)
     tok[k++] = (char)c;
     c = in_getc(in);
   }
+  in->eol = c == '\n' || c < 0;
   tok[k] = '\0';
+  return 0;
+}
+
+/* After the last value of an ASCII row: only blanks up to the line's end
+ * (0), or -3 when the row holds more values than the header declares. */
+static int
+in_row_end(ply_in* in)
+{
+  int c = 0;
+  while (!in->eol && (c = in_getc(in)) != '\n' && c >= 0)
+    if (c != ' ' && c != '\t' && c != '\r')
+      return -3;
+  in->eol = 0;
   return 0;
 }
 
@@ -585,13 +606,14 @@ read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
 
 /* One value of type t: binary via the buffer, ASCII via a token. */
 static int
-read_value(ply_in* in, int format, ply_type t, double* v)
+read_value(ply_in* in, int format, ply_type t, double* v, int first)
 {
   if (format == FMT_ASCII) {
     char tok[128];
     char* end;
-    if (in_token(in, tok, sizeof(tok)) != 0)
-      return -1;
+    const int rc = in_token(in, tok, sizeof(tok), first);
+    if (rc != 0)
+      return rc == -3 ? -3 : -1;
     *v = strtod(tok, &end);
     return *end == '\0' ? 0 : -2;
   }
@@ -614,14 +636,14 @@ read_row(ply_in* in, int format, const ply_element* e, double vals[6])
     int rc;
     if (p->count_type != T_NONE) {
       double cnt;
-      rc = read_value(in, format, p->count_type, &cnt);
+      rc = read_value(in, format, p->count_type, &cnt, j == 0);
       if (rc != 0)
         return rc;
       if (!(cnt >= 0.0) || cnt > 4294967295.0 || cnt != (double)(uint64_t)cnt)
         return -2;
       if (format == FMT_ASCII) {
         for (uint64_t k = 0; k < (uint64_t)cnt; ++k)
-          if ((rc = read_value(in, format, p->type, &v)) != 0)
+          if ((rc = read_value(in, format, p->type, &v, 0)) != 0)
             return rc;
       }
       else if (in_skip(in, (uint64_t)cnt * type_size(p->type)) != 0) {
@@ -629,13 +651,13 @@ read_row(ply_in* in, int format, const ply_element* e, double vals[6])
       }
       continue;
     }
-    rc = read_value(in, format, p->type, &v);
+    rc = read_value(in, format, p->type, &v, j == 0);
     if (rc != 0)
       return rc;
     if (p->role >= 0)
       vals[p->role] = v;
   }
-  return 0;
+  return format == FMT_ASCII ? in_row_end(in) : 0;
 }
 
 /* Smallest number of bytes one row can take (lists counted as empty). */
@@ -716,7 +738,9 @@ skip_elements_before(ply_in* in,
                           errlen,
                           "'%s': %s in element '%s' row %llu",
                           path,
-                          rc == -1 ? "unexpected end of file" : "bad value",
+                          rc == -1   ? "unexpected end of file"
+                          : rc == -3 ? "a row with more or fewer values than its properties"
+                                     : "bad value",
                           e->name,
                           (unsigned long long)i);
         return DACPO_PLY_ERR_FORMAT;
@@ -786,7 +810,9 @@ read_vertices(ply_in* in,
                         errlen,
                         "'%s': %s at vertex %zu of %zu",
                         path,
-                        rc == -1 ? "unexpected end of file (truncated)" : "bad value",
+                        rc == -1   ? "unexpected end of file (truncated)"
+                        : rc == -3 ? "a row with more or fewer values than the header's properties"
+                                   : "bad value",
                         i,
                         c->n);
       return DACPO_PLY_ERR_FORMAT;

@@ -29,6 +29,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "dacpo_mpi_tiles.h"
+#include "dacpo_paths.h"
 
 #include "dacpo_ply.h"
 #include "dacpo_tiled.h"
@@ -569,7 +570,11 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
   char tmp[4200];
   long pid = (long)getpid();
   MPI_Bcast(&pid, 1, MPI_LONG, 0, MPI_COMM_WORLD);
-  snprintf(tmp, sizeof(tmp), "%s.tmp%ld", path, pid);
+  if (dacpo_temp_sibling(path, "tmp", pid, tmp, sizeof(tmp)) != 0) {
+    if (t->rank == 0)
+      fprintf(stderr, "Error: '%s': name too long for a temporary file beside it\n", path);
+    return 0;
+  }
   char header[512];
   const int hlen = dacpo_tiled_header(header, sizeof(header), t->T, t->n);
   MPI_File fh;

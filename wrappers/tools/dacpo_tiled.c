@@ -22,6 +22,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "dacpo_tiled.h"
+#include "dacpo_paths.h"
 
 #include "dacpo_ply.h"
 
@@ -307,7 +308,9 @@ read_at(int fd, void* buf, size_t len, off_t off)
 static int
 create_output(tiled_run* r, char* err, size_t errlen)
 {
-  snprintf(r->out_tmp, sizeof(r->out_tmp), "%s.tmp%ld", r->opt->output, (long)getpid());
+  if (dacpo_temp_sibling(r->opt->output, "tmp", (long)getpid(), r->out_tmp, sizeof(r->out_tmp)) != 0)
+    return fail(err, errlen, "'%s': name too long for a temporary file beside it",
+                r->opt->output);
   r->out_fd = open(r->out_tmp, O_RDWR | O_CREAT | O_TRUNC, 0644);
   if (r->out_fd < 0)
     return fail(err, errlen, "cannot create '%s': %s", r->out_tmp, strerror(errno));
@@ -582,7 +585,16 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
       else
         snprintf(dir, sizeof(dir), ".");
     }
-    snprintf(r.tmp_prefix, sizeof(r.tmp_prefix), "%s/.dacpo%ld", dir, (long)getpid());
+    const int len =
+        snprintf(r.tmp_prefix, sizeof(r.tmp_prefix), "%s/.dacpo%ld", dir, (long)getpid());
+    char probe[4096];
+    /* the longest tile name must fit, and the output's temporary sibling */
+    if (len <= 0 || (size_t)len + 32 > sizeof(r.tmp_prefix) ||
+        dacpo_temp_sibling(opt->output, "tmp", (long)getpid(), probe, sizeof(probe)) != 0) {
+      free(r.chunk);
+      return fail(err, errlen, "'%s': name too long for temporary files beside it",
+                  opt->output);
+    }
   }
   double t0 = now_s();
   int rc = dacpo_ply_rows_open(opt->input, &r.rows, err, errlen) != 0;

@@ -18,6 +18,7 @@
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
 
+#include "dacpo_paths.h"
 #include "dacpo_scene.h"
 #include "dacpo_tool_io.h"
 
@@ -413,6 +414,14 @@ parseEvalOptions(int argc, char** argv, EvalOptions& o, int& exit_code)
     print_error("Error: -colored needs a .pcd file name, got '%s'\n",
                 o.colored.c_str());
     return false;
+  }
+  /* a folder that does not exist is said now, not after the scoring */
+  for (const std::string* path : {&o.colored, &o.normals_colored}) {
+    char err[512];
+    if (!path->empty() && dacpo_output_path_check(path->c_str(), err, sizeof(err)) != 0) {
+      print_error("Error: %s\n", err);
+      return false;
+    }
   }
   return true;
 }

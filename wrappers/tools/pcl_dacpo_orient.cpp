@@ -18,6 +18,7 @@
 #include <pcl/point_types.h>
 #include <pcl/PolygonMesh.h>
 
+#include "dacpo_paths.h"
 #include "dacpo_ply.h"
 #include "dacpo_tiled.h"
 #include "dacpo_tool_io.h"
@@ -1229,6 +1230,15 @@ printStats(const Result& result)
 int
 orientFile(const std::string& in, const std::string& out, const Options& options)
 {
+  /* every output's folder is checked before the work, not after it */
+  for (const std::string* path :
+       {&out, &options.edges, &options.blocks_colored, &options.normals_colored, &options.mesh}) {
+    char err[512];
+    if (!path->empty() && dacpo_output_path_check(path->c_str(), err, sizeof(err)) != 0) {
+      print_error("Error: %s\n", err);
+      return 1;
+    }
+  }
   if (options.memory > 0.0 || options.tile_points > 0) {
     const int tiled = orientTiled(in, out, options);
     if (tiled != kFitsInCore)

@@ -46,6 +46,7 @@
 #include "dacpo_mpi_knn.h"
 #include "dacpo_mpi_tiles.h"
 #include "dacpo_tiled.h"
+#include "dacpo_paths.h"
 #include "dacpo_pcd.h"
 #include <sys/resource.h>
 
@@ -197,6 +198,15 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
     return 0;
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
+    return 0;
+  /* outputs are checked before the work: a known format, a writable folder */
+  const size_t ol = strlen(o->out);
+  if (!dacpo_is_pcd_path(o->out) && (ol < 4 || strcmp(o->out + ol - 4, ".ply") != 0)) {
+    snprintf(msg, msg_size, "the output must be a .ply or .pcd file, got %s", o->out);
+    return 0;
+  }
+  if (dacpo_output_path_check(o->out, msg, msg_size) != 0 ||
+      (o->report && dacpo_output_path_check(o->report, msg, msg_size) != 0))
     return 0;
   return 1;
 }
@@ -511,12 +521,14 @@ create_job(dacpo_ctx* ctx,
   return 1;
 }
 
-static void
+static int
 write_report(const options* o, const rank_report* all, int ranks)
 {
   FILE* f = o->report ? fopen(o->report, "w") : NULL;
-  if (o->report && !f)
+  if (o->report && !f) {
     fprintf(stderr, "Error: cannot write %s: %s\n", o->report, strerror(errno));
+    return 0;
+  }
   if (!o->quiet)
     printf("rank  read+0-1    knn  blocks   edges  solve  write   busy  peak RSS MB  "
            "sent MB  recv MB  blocks edges\n");
@@ -563,8 +575,11 @@ write_report(const options* o, const rank_report* all, int ranks)
           x->blocks,
           x->edges);
   }
-  if (f)
-    fclose(f);
+  if (f && fclose(f) != 0) {
+    fprintf(stderr, "Error: cannot write %s: %s\n", o->report, strerror(errno));
+    return 0;
+  }
+  return 1;
 }
 
 /* Stages 2-6 over the ranks (or dacpo_orient() on rank 0 with -whole). */
@@ -621,11 +636,12 @@ static int
 write_output(const char* path, const dacpo_ply_cloud* cloud)
 {
   char msg[512];
-  const size_t len = strlen(path) + 32;
+  const size_t len = strlen(path) + 64;
   char* tmp = malloc(len);
-  int ok = tmp != NULL;
+  int ok = tmp != NULL && dacpo_temp_sibling(path, "tmp", (long)getpid(), tmp, len) == 0;
+  if (tmp && !ok)
+    fprintf(stderr, "Error: '%s': name too long for a temporary file beside it\n", path);
   if (ok) {
-    snprintf(tmp, len, "%s.tmp%ld", path, (long)getpid());
     /* the format of the target's name, not of the temporary one */
     int (*write)(
         const char*, const float*, const float*, size_t, const char*, char*, size_t) =
@@ -663,7 +679,7 @@ tiled_main(const options* o, int rank, int ranks)
   }
   dacpo_mpi_tiles_report rep;
   const double t0 = now();
-  const int ok =
+  int ok =
       dacpo_mpi_tiles_orient(o->in, o->out, &o->p, o->tile_points, o->tile_halo, rank, ranks, &rep);
   const double wall = now() - t0;
   const double rss = peak_rss_mb();
@@ -694,8 +710,10 @@ tiled_main(const options* o, int rank, int ranks)
                 r, ranks, rep.num_tiles, rep.halo, x[0], x[1], x[2], x[3], x[4], x[5], x[6],
                 x[7], x[8], x[9], x[10], x[11]);
     }
-    if (f)
-      fclose(f);
+    if (o->report && (!f || fclose(f) != 0)) {
+      fprintf(stderr, "Error: cannot write %s: %s\n", o->report, strerror(errno));
+      ok = 0;
+    }
   }
   free(all);
   MPI_Finalize();
@@ -825,7 +843,7 @@ main(int argc, char** argv)
              0,
              MPI_COMM_WORLD);
   if (rank == 0 && all && ok)
-    write_report(&o, all, ranks);
+    ok = write_report(&o, all, ranks);
   free(all);
   dacpo_job_free(job);
   dacpo_ctx_free(ctx);

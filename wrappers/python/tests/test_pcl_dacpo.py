@@ -87,6 +87,11 @@ def test_unknown_parameter_names_the_nearest():
         pcl_dacpo.orient(pts, kk=5)
     with pytest.raises(TypeError, match="seed must be an int"):
         pcl_dacpo.orient(pts, seed="one")
+    # ints too large for the C field are a ValueError naming the keyword
+    with pytest.raises(ValueError, match="k=.*not a value"):
+        pcl_dacpo.orient(pts, k=2**70)
+    with pytest.raises(ValueError, match="seed=.*not a value"):
+        pcl_dacpo.orient(pts, seed=2**64)
     with pytest.raises(ValueError, match="dipole_c"):
         pcl_dacpo.orient(pts, dipole_c=0.5)
     with pytest.raises(ValueError, match="edge_weight must be one of"):
