@@ -1166,8 +1166,66 @@ syncFile(const std::string& path, std::string& error)
   return ok;
 }
 
-/** Size a binary little-endian PLY must have: its header plus, per element,
- *  count x record size (no list properties). 0 if that cannot be told. */
+namespace detail {
+/** Bytes of a PLY scalar type, 0 for an unknown name. */
+inline unsigned
+plyTypeBytes(const std::string& type)
+{
+  static const char* const names[][2] = {
+      {"char", "1"},   {"uchar", "1"},  {"int8", "1"},    {"uint8", "1"},   {"short", "2"},
+      {"ushort", "2"}, {"int16", "2"},  {"uint16", "2"},  {"int", "4"},     {"uint", "4"},
+      {"float", "4"},  {"int32", "4"},  {"uint32", "4"},  {"float32", "4"}, {"double", "8"},
+      {"float64", "8"}};
+  for (const auto& n : names)
+    if (type == n[0])
+      return static_cast<unsigned>(n[1][0] - '0');
+  return 0;
+}
+
+/** One element of a PLY header: its row count and, per property, the bytes of
+ *  a scalar, or of a list's count and items. */
+struct PlyElementLayout {
+  unsigned long long count = 0;
+  std::vector<std::pair<unsigned, unsigned>> props; /* (count bytes or 0, item bytes) */
+};
+
+/** Bytes of the rows of e starting at the current offset of f: count x record
+ *  for scalar rows; list rows (PCL's range_grid of organized clouds) are walked
+ *  count by count. -1 when the data ends first or a count is malformed. */
+inline long long
+plyElementBytes(std::FILE* f, const PlyElementLayout& e)
+{
+  unsigned long long record = 0;
+  bool lists = false;
+  for (const auto& p : e.props) {
+    record += p.first ? 0 : p.second;
+    lists = lists || p.first != 0;
+  }
+  if (!lists)
+    return static_cast<long long>(e.count * record);
+  long long bytes = 0;
+  for (unsigned long long r = 0; r < e.count; ++r)
+    for (const auto& p : e.props) {
+      unsigned long long n = 1;
+      if (p.first) {
+        unsigned char c[4] = {0, 0, 0, 0};
+        if (p.first > 4 || std::fread(c, 1, p.first, f) != p.first)
+          return -1;
+        n = c[0] | (c[1] << 8) | (static_cast<unsigned long long>(c[2]) << 16) |
+            (static_cast<unsigned long long>(c[3]) << 24);
+        bytes += p.first;
+      }
+      if (::fseeko(f, static_cast<off_t>(n * p.second), SEEK_CUR) != 0)
+        return -1;
+      bytes += static_cast<long long>(n * p.second);
+    }
+  return bytes;
+}
+} // namespace detail
+
+/** Size a binary little-endian PLY must have: its header plus the bytes of
+ *  every element's rows (list rows walked one by one). 0 if that cannot be
+ *  told (not binary little-endian, an unknown type, data that ends early). */
 inline long long
 expectedBinaryPlySize(const std::string& path)
 {
@@ -1175,45 +1233,39 @@ expectedBinaryPlySize(const std::string& path)
   if (!f)
     return 0;
   std::string line;
-  unsigned long long total = 0, count = 0, record = 0;
+  std::vector<detail::PlyElementLayout> elements;
   bool binary = false, ok = true;
-  auto flush = [&] { total += count * record; };
-  while (detail::readLine(f, line, 4096)) {
+  while (ok && detail::readLine(f, line, 4096)) {
     const std::vector<std::string> t = detail::tokens(line);
     if (t.empty())
       continue;
     if (t[0] == "format")
       binary = t.size() >= 2 && t[1] == "binary_little_endian";
     else if (t[0] == "element" && t.size() == 3) {
-      flush();
-      count = std::strtoull(t[2].c_str(), nullptr, 10);
-      record = 0;
+      elements.emplace_back();
+      elements.back().count = std::strtoull(t[2].c_str(), nullptr, 10);
     }
-    else if (t[0] == "property" && t.size() == 3) {
-      static const char* const one[] = {"char", "uchar", "int8", "uint8"};
-      static const char* const two[] = {"short", "ushort", "int16", "uint16"};
-      static const char* const four[] = {
-          "int", "uint", "float", "int32", "uint32", "float32"};
-      static const char* const eight[] = {"double", "float64"};
-      auto is = [&](const char* const* list, std::size_t n) {
-        return std::any_of(list, list + n, [&](const char* x) { return t[1] == x; });
-      };
-      record += is(one, 4)     ? 1
-                : is(two, 4)   ? 2
-                : is(four, 6)  ? 4
-                : is(eight, 2) ? 8
-                               : 0;
-      ok = ok && (is(one, 4) || is(two, 4) || is(four, 6) || is(eight, 2));
+    else if (t[0] == "property" && !elements.empty()) {
+      const bool list = t.size() == 5 && t[1] == "list";
+      const unsigned c = list ? detail::plyTypeBytes(t[2]) : 0;
+      const unsigned v = detail::plyTypeBytes(t[list ? 3 : 1]);
+      ok = v != 0 && (list ? c != 0 : t.size() == 3);
+      elements.back().props.emplace_back(c, v);
     }
-    else if (t[0] == "property")
-      ok = false; /* a list */
     else if (t[0] == "end_header")
       break;
   }
-  flush();
-  const long long header = std::ftell(f);
+  long long total = std::ftell(f);
+  for (std::size_t i = 0; ok && binary && i < elements.size(); ++i) {
+    const long long b = detail::plyElementBytes(f, elements[i]);
+    ok = b >= 0;
+    total += b;
+    /* a scalar element was not read past: move over it for the next one */
+    if (ok && i + 1 < elements.size())
+      ok = ::fseeko(f, static_cast<off_t>(total), SEEK_SET) == 0;
+  }
   std::fclose(f);
-  return binary && ok ? header + static_cast<long long>(total) : 0;
+  return binary && ok ? total : 0;
 }
 
 /** Produces \a path through a temporary file beside it: \a produce writes the
