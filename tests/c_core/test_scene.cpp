@@ -635,6 +635,38 @@ TEST(DacpoPly, WriteReadRoundTripIsBitExact)
   std::remove(path.c_str());
 }
 
+// Georeferenced double coordinates: written as double, read back exactly by
+// dacpo_ply_read_exact (xyz_exact bit for bit, xyz the offsets from vertex 0);
+// dacpo_ply_read keeps its float contract (no xyz_exact, no origin).
+TEST(DacpoPly, DoubleCoordinatesRoundTripExactly)
+{
+  const double xyz[9] = {4.0e5 + 0.123456789, 5.4e6 + 0.5, 120.25,
+                         4.0e5 + 1.000000001, 5.4e6 + 0.75, 120.0,
+                         4.0e5, 5.4e6, 119.0};
+  const float nrm[9] = {0, 0, 1, 0, 1, 0, 1, 0, 0};
+  const std::string path = TempPath("double.ply");
+  char err[256];
+  ASSERT_EQ(dacpo_ply_write_exact(path.c_str(), xyz, nrm, 3, nullptr, err, sizeof(err)),
+            DACPO_PLY_OK)
+      << err;
+  dacpo_ply_cloud c;
+  ASSERT_EQ(dacpo_ply_read_exact(path.c_str(), &c, err, sizeof(err)), DACPO_PLY_OK) << err;
+  ASSERT_NE(c.xyz_exact, nullptr);
+  EXPECT_EQ(std::memcmp(c.xyz_exact, xyz, sizeof(xyz)), 0);
+  for (int k = 0; k < 9; ++k) {
+    EXPECT_EQ(c.xyz[k], static_cast<float>(xyz[k] - xyz[k % 3])) << k;
+    EXPECT_EQ(c.normals[k], nrm[k]);
+  }
+  EXPECT_EQ(c.origin[0], xyz[0]);
+  dacpo_ply_cloud_free(&c);
+  ASSERT_EQ(dacpo_ply_read(path.c_str(), &c, err, sizeof(err)), DACPO_PLY_OK) << err;
+  EXPECT_EQ(c.xyz_exact, nullptr);
+  EXPECT_EQ(c.origin[0], 0.0);
+  EXPECT_EQ(c.xyz[0], static_cast<float>(xyz[0]));
+  dacpo_ply_cloud_free(&c);
+  std::remove(path.c_str());
+}
+
 TEST(DacpoPly, ReadsExtraPropertiesElementsAndFormats)
 {
   char err[256];

@@ -47,6 +47,16 @@ put_f32le(unsigned char* p, float f)
   return p + 4;
 }
 
+static unsigned char*
+put_f64le(unsigned char* p, double d)
+{
+  uint64_t u;
+  memcpy(&u, &d, sizeof(u));
+  for (int b = 0; b < 8; ++b)
+    p[b] = (unsigned char)((u >> (8 * b)) & 0xffu);
+  return p + 8;
+}
+
 /* Each line of `comment` becomes one "comment" header line. */
 static int
 write_comments(FILE* f, const char* comment)
@@ -66,16 +76,19 @@ write_comments(FILE* f, const char* comment)
   return 0;
 }
 
-int
-dacpo_ply_write(const char* path,
-                const float* xyz,
-                const float* normals,
-                size_t n,
-                const char* comment,
-                char* err,
-                size_t errlen)
+/* Float (xyz) or double (xyz_d) coordinates, float normals when given. */
+static int
+ply_write(const char* path,
+          const float* xyz,
+          const double* xyz_d,
+          const float* normals,
+          size_t n,
+          const char* comment,
+          char* err,
+          size_t errlen)
 {
-  const size_t per = normals ? 6 : 3;
+  const size_t per = 3 * (xyz_d ? 2 : 1) + (normals ? 3 : 0);
+  const char* type = xyz_d ? "double" : "float";
   const size_t chunk = 4096;
   unsigned char* buf;
   FILE* f;
@@ -83,12 +96,12 @@ dacpo_ply_write(const char* path,
 
   if (err && errlen > 0)
     err[0] = '\0';
-  if (!path || (!xyz && n > 0)) {
+  if (!path || (!xyz && !xyz_d && n > 0)) {
     dacpo_support_err(
         err, errlen, "dacpo_ply_write: %s is NULL", !path ? "path" : "xyz");
     return DACPO_PLY_ERR_ARGUMENT;
   }
-  buf = (unsigned char*)malloc(chunk * per * 4);
+  buf = (unsigned char*)malloc(chunk * per * 4); /* per counts 4-byte words */
   if (!buf) {
     dacpo_support_err(err, errlen, "out of memory");
     return DACPO_PLY_ERR_MEMORY;
@@ -103,9 +116,11 @@ dacpo_ply_write(const char* path,
   if (fprintf(f, "ply\nformat binary_little_endian 1.0\n") < 0 ||
       write_comments(f, comment) != 0 ||
       fprintf(f,
-              "element vertex %zu\nproperty float x\nproperty float y\n"
-              "property float z\n",
-              n) < 0 ||
+              "element vertex %zu\nproperty %s x\nproperty %s y\nproperty %s z\n",
+              n,
+              type,
+              type,
+              type) < 0 ||
       (normals && fprintf(f,
                           "property float nx\nproperty float ny\n"
                           "property float nz\n") < 0) ||
@@ -116,7 +131,7 @@ dacpo_ply_write(const char* path,
     unsigned char* p = buf;
     for (size_t i = i0; i < i0 + m; ++i) {
       for (size_t k = 0; k < 3; ++k)
-        p = put_f32le(p, xyz[3 * i + k]);
+        p = xyz_d ? put_f64le(p, xyz_d[3 * i + k]) : put_f32le(p, xyz[3 * i + k]);
       if (normals)
         for (size_t k = 0; k < 3; ++k)
           p = put_f32le(p, normals[3 * i + k]);
@@ -136,6 +151,30 @@ dacpo_ply_write(const char* path,
     return DACPO_PLY_ERR_IO;
   }
   return DACPO_PLY_OK;
+}
+
+int
+dacpo_ply_write(const char* path,
+                const float* xyz,
+                const float* normals,
+                size_t n,
+                const char* comment,
+                char* err,
+                size_t errlen)
+{
+  return ply_write(path, xyz, NULL, normals, n, comment, err, errlen);
+}
+
+int
+dacpo_ply_write_exact(const char* path,
+                      const double* xyz,
+                      const float* normals,
+                      size_t n,
+                      const char* comment,
+                      char* err,
+                      size_t errlen)
+{
+  return ply_write(path, NULL, xyz, normals, n, comment, err, errlen);
 }
 
 /* ------------------------------------------------------------------------- */
@@ -349,6 +388,13 @@ type_size(ply_type t)
     break;
   }
   return 0;
+}
+
+/* 1 when a value of type t converts to float exactly. */
+static int
+exact_in_float(ply_type t)
+{
+  return t != T_F64 && t != T_I32 && t != T_U32;
 }
 
 static int
@@ -781,23 +827,40 @@ check_vertex_count(const ply_in* in,
   return DACPO_PLY_OK;
 }
 
-/* Decodes the vertex rows into c (positions, and normals if has_normals). */
+/* 1 when x, y or z of vert has a type float cannot hold exactly. */
+static int
+vertex_needs_double(const ply_element* vert)
+{
+  for (int j = 0; j < vert->nprops; ++j)
+    if (vert->props[j].role >= 0 && vert->props[j].role < 3 &&
+        !exact_in_float(vert->props[j].type))
+      return 1;
+  return 0;
+}
+
+/* Decodes the vertex rows into c (positions, and normals if has_normals);
+ * with exact, coordinates float cannot hold go to c->xyz_exact as read and
+ * to c->xyz as offsets from vertex 0 (c->origin). */
 static int
 read_vertices(ply_in* in,
               int format,
               const ply_element* vert,
               int has_normals,
+              int exact,
               dacpo_ply_cloud* c,
               const char* path,
               char* err,
               size_t errlen)
 {
   c->n = (size_t)vert->count;
+  exact = exact && vertex_needs_double(vert);
   if (c->n > 0) {
     c->xyz = (float*)malloc(3 * c->n * sizeof(float));
     if (has_normals)
       c->normals = (float*)malloc(3 * c->n * sizeof(float));
-    if (!c->xyz || (has_normals && !c->normals)) {
+    if (exact)
+      c->xyz_exact = (double*)malloc(3 * c->n * sizeof(double));
+    if (!c->xyz || (has_normals && !c->normals) || (exact && !c->xyz_exact)) {
       dacpo_support_err(err, errlen, "out of memory reading %zu vertices", c->n);
       return DACPO_PLY_ERR_MEMORY;
     }
@@ -817,8 +880,13 @@ read_vertices(ply_in* in,
                         c->n);
       return DACPO_PLY_ERR_FORMAT;
     }
-    for (int k = 0; k < 3; ++k)
-      c->xyz[3 * i + (size_t)k] = (float)v[k];
+    if (exact && i == 0)
+      memcpy(c->origin, v, sizeof(c->origin));
+    for (int k = 0; k < 3; ++k) {
+      c->xyz[3 * i + (size_t)k] = (float)(v[k] - c->origin[k]);
+      if (exact)
+        c->xyz_exact[3 * i + (size_t)k] = v[k];
+    }
     if (has_normals)
       for (int k = 0; k < 3; ++k)
         c->normals[3 * i + (size_t)k] = (float)v[3 + k];
@@ -893,8 +961,23 @@ ply_close(ply_in* in, ply_header* h)
     fclose(in->f);
 }
 
+static int
+ply_read(const char* path, int exact, dacpo_ply_cloud* out, char* err, size_t errlen);
+
 int
 dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
+{
+  return ply_read(path, 0, out, err, errlen);
+}
+
+int
+dacpo_ply_read_exact(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
+{
+  return ply_read(path, 1, out, err, errlen);
+}
+
+static int
+ply_read(const char* path, int exact, dacpo_ply_cloud* out, char* err, size_t errlen)
 {
   ply_in in;
   ply_header h;
@@ -914,7 +997,7 @@ dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
   memset(&c, 0, sizeof(c));
   int status = open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
   if (status == DACPO_PLY_OK)
-    status = read_vertices(&in, h.format, vert, has_normals, &c, path, err, errlen);
+    status = read_vertices(&in, h.format, vert, has_normals, exact, &c, path, err, errlen);
   if (status == DACPO_PLY_OK && ferror(in.f)) {
     dacpo_support_err(err, errlen, "read error on '%s'", path);
     status = DACPO_PLY_ERR_IO;
@@ -976,16 +1059,18 @@ dacpo_ply_rows_open(const char* path, dacpo_ply_rows* out, char* err, size_t err
   return status;
 }
 
-int
-dacpo_ply_rows_read(FILE* f,
-                    const dacpo_ply_rows* rows,
-                    unsigned long long first,
-                    size_t count,
-                    float* xyz,
-                    char* err,
-                    size_t errlen)
+/* Calls emit(rows, row, i, user) for the rows [first, first + count) of f. */
+static int
+rows_walk(FILE* f,
+          const dacpo_ply_rows* rows,
+          unsigned long long first,
+          size_t count,
+          void (*emit)(const dacpo_ply_rows*, const unsigned char*, size_t, void*),
+          void* user,
+          char* err,
+          size_t errlen)
 {
-  if (!f || !rows || (!xyz && count > 0) || first > rows->n || count > rows->n - first) {
+  if (!f || !rows || (!user && count > 0) || first > rows->n || count > rows->n - first) {
     dacpo_support_err(err, errlen, "dacpo_ply_rows_read: bad argument or range");
     return DACPO_PLY_ERR_ARGUMENT;
   }
@@ -1002,11 +1087,112 @@ dacpo_ply_rows_read(FILE* f,
       return DACPO_PLY_ERR_IO;
     }
     for (size_t i = 0; i < take; ++i)
-      for (int k = 0; k < 3; ++k)
-        xyz[3 * (done + i) + (size_t)k] = (float)decode(
-            buf + i * rows->stride + rows->offset[k], (ply_type)rows->type[k], rows->swap);
+      emit(rows, buf + i * rows->stride, done + i, user);
     done += take;
   }
+  return DACPO_PLY_OK;
+}
+
+static void
+emit_float(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
+{
+  float* xyz = (float*)user;
+  for (int k = 0; k < 3; ++k)
+    xyz[3 * i + (size_t)k] =
+        (float)(decode(row + rows->offset[k], (ply_type)rows->type[k], rows->swap) -
+                rows->origin[k]);
+}
+
+static void
+emit_double(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
+{
+  double* xyz = (double*)user;
+  for (int k = 0; k < 3; ++k)
+    xyz[3 * i + (size_t)k] = decode(row + rows->offset[k], (ply_type)rows->type[k], rows->swap);
+}
+
+static void
+emit_raw(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
+{
+  unsigned char* out = (unsigned char*)user + i * dacpo_ply_rows_xyz_bytes(rows);
+  for (int k = 0; k < 3; ++k) {
+    const size_t sz = type_size((ply_type)rows->type[k]);
+    for (size_t b = 0; b < sz; ++b) /* little-endian, as the output is */
+      *out++ = row[rows->offset[k] + (rows->swap ? sz - 1 - b : b)];
+  }
+}
+
+int
+dacpo_ply_rows_read(FILE* f,
+                    const dacpo_ply_rows* rows,
+                    unsigned long long first,
+                    size_t count,
+                    float* xyz,
+                    char* err,
+                    size_t errlen)
+{
+  return rows_walk(f, rows, first, count, emit_float, xyz, err, errlen);
+}
+
+int
+dacpo_ply_rows_read_double(FILE* f,
+                           const dacpo_ply_rows* rows,
+                           unsigned long long first,
+                           size_t count,
+                           double* xyz,
+                           char* err,
+                           size_t errlen)
+{
+  return rows_walk(f, rows, first, count, emit_double, xyz, err, errlen);
+}
+
+int
+dacpo_ply_rows_read_raw(FILE* f,
+                        const dacpo_ply_rows* rows,
+                        unsigned long long first,
+                        size_t count,
+                        unsigned char* out,
+                        char* err,
+                        size_t errlen)
+{
+  return rows_walk(f, rows, first, count, emit_raw, out, err, errlen);
+}
+
+size_t
+dacpo_ply_rows_xyz_bytes(const dacpo_ply_rows* rows)
+{
+  size_t b = 0;
+  for (int k = 0; k < 3; ++k)
+    b += type_size((ply_type)rows->type[k]);
+  return b;
+}
+
+int
+dacpo_ply_rows_exact_in_float(const dacpo_ply_rows* rows)
+{
+  return exact_in_float((ply_type)rows->type[0]) && exact_in_float((ply_type)rows->type[1]) &&
+         exact_in_float((ply_type)rows->type[2]);
+}
+
+const char*
+dacpo_ply_rows_type_name(const dacpo_ply_rows* rows, int k)
+{
+  static const char* const names[] = {"float", "char", "uchar", "short", "ushort",
+                                      "int",   "uint", "float", "double"};
+  const int t = rows->type[k];
+  return t >= 0 && t < (int)(sizeof(names) / sizeof(names[0])) ? names[t] : "float";
+}
+
+int
+dacpo_ply_rows_set_origin(FILE* f, dacpo_ply_rows* rows, char* err, size_t errlen)
+{
+  double p[3] = {0.0, 0.0, 0.0};
+  if (rows->n > 0 && !dacpo_ply_rows_exact_in_float(rows)) {
+    const int rc = dacpo_ply_rows_read_double(f, rows, 0, 1, p, err, errlen);
+    if (rc != DACPO_PLY_OK)
+      return rc;
+  }
+  memcpy(rows->origin, p, sizeof(p));
   return DACPO_PLY_OK;
 }
 
@@ -1017,5 +1203,6 @@ dacpo_ply_cloud_free(dacpo_ply_cloud* cloud)
     return;
   free(cloud->xyz);
   free(cloud->normals);
+  free(cloud->xyz_exact);
   memset(cloud, 0, sizeof(*cloud));
 }

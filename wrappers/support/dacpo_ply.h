@@ -38,6 +38,9 @@ typedef struct dacpo_ply_cloud {
   size_t n;       /**< number of vertices */
   float* xyz;     /**< 3n coordinates (NULL when n == 0) */
   float* normals; /**< 3n normals, or NULL when the file has no nx, ny, nz */
+  double* xyz_exact; /**< dacpo_ply_read_exact only: 3n coordinates as read when
+                          float cannot hold them (double, 32-bit int), else NULL */
+  double origin[3];  /**< xyz = xyz_exact - origin (vertex 0), 0 otherwise */
 } dacpo_ply_cloud;
 
 /**
@@ -66,6 +69,27 @@ dacpo_ply_write(const char* path,
 int
 dacpo_ply_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen);
 
+/**
+ * \brief As dacpo_ply_read, for files whose coordinates float cannot hold (a
+ *  georeferenced double file): they are kept in xyz_exact, and xyz holds their
+ *  offsets from vertex 0 (origin), where float keeps sub-millimetre steps.
+ */
+int
+dacpo_ply_read_exact(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen);
+
+/**
+ * \brief Write n points as binary little-endian PLY with double x y z (float
+ *  normals): the coordinates of dacpo_ply_read_exact written back unchanged.
+ */
+int
+dacpo_ply_write_exact(const char* path,
+                      const double* xyz,
+                      const float* normals,
+                      size_t n,
+                      const char* comment,
+                      char* err,
+                      size_t errlen);
+
 /** \brief Where the vertex rows of a binary PLY lie, for reading any range of
  *  them without the rest (out-of-core and per-rank reading). Needs
  *  binary_little_endian or binary_big_endian and vertex rows of scalar
@@ -77,6 +101,8 @@ typedef struct dacpo_ply_rows {
   size_t offset[3];               /**< x, y, z within a row */
   int type[3];                    /**< their scalar types (internal codes) */
   int swap;                       /**< 1: big-endian values */
+  double origin[3]; /**< subtracted before the float conversion of
+                         dacpo_ply_rows_read (0 after open; see set_origin) */
 } dacpo_ply_rows;
 
 /**
@@ -101,6 +127,47 @@ dacpo_ply_rows_read(FILE* f,
                     float* xyz,
                     char* err,
                     size_t errlen);
+
+/** \brief As dacpo_ply_rows_read, the exact values as double (origin not applied). */
+int
+dacpo_ply_rows_read_double(FILE* f,
+                           const dacpo_ply_rows* rows,
+                           unsigned long long first,
+                           size_t count,
+                           double* xyz,
+                           char* err,
+                           size_t errlen);
+
+/** \brief The x, y, z bytes of each row as stored, turned little-endian
+ *  (dacpo_ply_rows_xyz_bytes per row): an output keeps the input's coordinates
+ *  bit for bit whatever their type. */
+int
+dacpo_ply_rows_read_raw(FILE* f,
+                        const dacpo_ply_rows* rows,
+                        unsigned long long first,
+                        size_t count,
+                        unsigned char* out,
+                        char* err,
+                        size_t errlen);
+
+/** \brief Bytes of x, y and z in one row (12 for float coordinates). */
+size_t
+dacpo_ply_rows_xyz_bytes(const dacpo_ply_rows* rows);
+
+/** \brief 1 when every coordinate type converts to float exactly (float and
+ *  the 8/16-bit integers), 0 for double and 32-bit integers. */
+int
+dacpo_ply_rows_exact_in_float(const dacpo_ply_rows* rows);
+
+/** \brief PLY type name of coordinate k (0 x, 1 y, 2 z), for an output header. */
+const char*
+dacpo_ply_rows_type_name(const dacpo_ply_rows* rows, int k);
+
+/** \brief Sets rows->origin to vertex 0 when the coordinates are not exact in
+ *  float (a georeferenced double file: floats of the offsets keep mm where
+ *  floats of the coordinates lose decimetres), to 0 otherwise. */
+int
+dacpo_ply_rows_set_origin(FILE* f, dacpo_ply_rows* rows, char* err, size_t errlen);
 
 /** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
 void

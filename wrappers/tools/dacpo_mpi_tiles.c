@@ -224,6 +224,8 @@ read_and_plan(tiles_run* t,
     snprintf(err, sizeof(err), "cannot open '%s': %s", path, strerror(errno));
     ok = 0;
   }
+  /* double coordinates: every rank computes on offsets from vertex 0 */
+  ok = ok && dacpo_ply_rows_set_origin(t->in, &t->rows, err, sizeof(err)) == 0;
   t->n = t->rows.n;
   t->lo = range_start(t->n, t->rank, t->ranks);
   t->hi = range_start(t->n, t->rank + 1, t->ranks);
@@ -575,8 +577,10 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
       fprintf(stderr, "Error: '%s': name too long for a temporary file beside it\n", path);
     return 0;
   }
-  char header[512];
-  const int hlen = dacpo_tiled_header(header, sizeof(header), t->T, t->n);
+  /* rows: the input's x y z bytes as stored (bit for bit), float normals */
+  char header[600];
+  const int hlen = dacpo_tiled_header_typed(header, sizeof(header), t->T, t->n, &t->rows);
+  const size_t xb = dacpo_ply_rows_xyz_bytes(&t->rows), row = xb + 12;
   MPI_File fh;
   ok = MPI_File_open(MPI_COMM_WORLD, tmp, MPI_MODE_CREATE | MPI_MODE_WRONLY, MPI_INFO_NULL, &fh) ==
        MPI_SUCCESS;
@@ -587,7 +591,7 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
   }
   /* the whole size is allocated on disk first (not a sparse set_size): a full
      disk fails here, before any row, and every write's count is checked */
-  const MPI_Offset total = (MPI_Offset)hlen + (MPI_Offset)(t->n * DACPO_TILED_OUT_BYTES);
+  const MPI_Offset total = (MPI_Offset)hlen + (MPI_Offset)(t->n * row);
   char err[512] = "";
   ok = MPI_File_preallocate(fh, total) == MPI_SUCCESS;
   if (!ok)
@@ -595,19 +599,19 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
   ok = dacpo_mpi_all_ok(ok);
   if (ok && t->rank == 0)
     ok = write_all_at(fh, 0, header, (size_t)hlen, err, sizeof(err));
-  float* rec = malloc((size_t)ROUND_POINTS * DACPO_TILED_OUT_BYTES);
+  unsigned char* rec = malloc((size_t)ROUND_POINTS * row);
   ok = ok && rec != NULL;
   for (uint64_t first = t->lo; ok && first < t->hi; first += ROUND_POINTS) {
     const size_t take = (size_t)(t->hi - first < ROUND_POINTS ? t->hi - first : ROUND_POINTS);
-    ok = dacpo_ply_rows_read(t->in, &t->rows, first, take, t->chunk, err, sizeof(err)) == 0;
-    for (size_t i = 0; ok && i < take; ++i) {
-      memcpy(rec + 6 * i, t->chunk + 3 * i, 12);
-      memcpy(rec + 6 * i + 3, t->range_nrm + 3 * (first - t->lo + i), 12);
+    ok = dacpo_ply_rows_read_raw(t->in, &t->rows, first, take, rec, err, sizeof(err)) == 0;
+    for (size_t i = take; ok && i-- > 0;) { /* from the end: rows grow in place */
+      memmove(rec + i * row, rec + i * xb, xb);
+      memcpy(rec + i * row + xb, t->range_nrm + 3 * (first - t->lo + i), 12);
     }
     ok = ok && write_all_at(fh,
-                            (MPI_Offset)hlen + (MPI_Offset)(first * DACPO_TILED_OUT_BYTES),
+                            (MPI_Offset)hlen + (MPI_Offset)(first * row),
                             rec,
-                            take * DACPO_TILED_OUT_BYTES,
+                            take * row,
                             err,
                             sizeof(err));
   }

@@ -65,17 +65,30 @@ now_s(void)
 }
 
 int
-dacpo_tiled_header(char* buf, size_t len, size_t tiles, uint64_t n)
+dacpo_tiled_header_typed(char* buf,
+                         size_t len,
+                         size_t tiles,
+                         uint64_t n,
+                         const struct dacpo_ply_rows* rows)
 {
   return snprintf(buf,
                   len,
                   "ply\nformat binary_little_endian 1.0\n"
                   "comment pcl_dacpo: normals oriented in %zu tiles\n"
-                  "element vertex %llu\nproperty float x\nproperty float y\n"
-                  "property float z\nproperty float nx\nproperty float ny\n"
+                  "element vertex %llu\nproperty %s x\nproperty %s y\n"
+                  "property %s z\nproperty float nx\nproperty float ny\n"
                   "property float nz\nend_header\n",
                   tiles,
-                  (unsigned long long)n);
+                  (unsigned long long)n,
+                  rows ? dacpo_ply_rows_type_name(rows, 0) : "float",
+                  rows ? dacpo_ply_rows_type_name(rows, 1) : "float",
+                  rows ? dacpo_ply_rows_type_name(rows, 2) : "float");
+}
+
+int
+dacpo_tiled_header(char* buf, size_t len, size_t tiles, uint64_t n)
+{
+  return dacpo_tiled_header_typed(buf, len, tiles, n, NULL);
 }
 
 uint64_t
@@ -551,6 +564,63 @@ apply_flips(tiled_run* r, const uint8_t* flip, char* err, size_t errlen)
   return 0;
 }
 
+/* Coordinates not exact in float (double input): the output is written again
+ * with the input's x y z bytes and the normals of the float file. */
+static int
+rewrite_exact(tiled_run* r, const char* path, char* err, size_t errlen)
+{
+  const size_t xb = dacpo_ply_rows_xyz_bytes(&r->rows);
+  char header[600];
+  const int hl = dacpo_tiled_header_typed(header, sizeof(header), r->T, r->rows.n, &r->rows);
+  FILE* out = fopen(path, "wb");
+  const size_t per = TILED_CHUNK / 2;
+  unsigned char* raw = malloc(per * (xb + 12));
+  float* rec = (float*)r->chunk; /* 6 floats per point: room for half a chunk */
+  int rc = out && raw && hl > 0 && fwrite(header, (size_t)hl, 1, out) == 1 ? 0 : -1;
+  for (uint64_t first = 0; rc == 0 && first < r->rows.n; first += per) {
+    const size_t take = (size_t)(r->rows.n - first < per ? r->rows.n - first : per);
+    rc = read_at(r->out_fd, rec, take * OUT_BYTES,
+                 (off_t)r->header_len + (off_t)(first * OUT_BYTES));
+    rc = rc == 0 ? dacpo_ply_rows_read_raw(r->in, &r->rows, first, take, raw, err, errlen) : rc;
+    for (size_t i = take; rc == 0 && i-- > 0;) { /* from the end: rows grow in place */
+      memmove(raw + i * (xb + 12), raw + i * xb, xb);
+      memcpy(raw + i * (xb + 12) + xb, rec + 6 * i + 3, 12);
+    }
+    if (rc == 0 && fwrite(raw, xb + 12, take, out) != take)
+      rc = -1;
+  }
+  if (out && (fflush(out) != 0 || fsync(fileno(out)) != 0))
+    rc = -1;
+  if (out && fclose(out) != 0)
+    rc = -1;
+  free(raw);
+  if (rc != 0)
+    remove(path);
+  return rc != 0 ? fail(err, errlen, "cannot write '%s': %s", path, strerror(errno)) : 0;
+}
+
+/* Sync the output and rename it onto the user's name. */
+static int
+finish_output(tiled_run* r, char* err, size_t errlen)
+{
+  const char* done = r->out_tmp;
+  char exact[4200];
+  if (fsync(r->out_fd) != 0)
+    return fail(err, errlen, "cannot write '%s': %s", r->out_tmp, strerror(errno));
+  if (!dacpo_ply_rows_exact_in_float(&r->rows)) {
+    if (dacpo_temp_sibling(r->opt->output, "exact", (long)getpid(), exact, sizeof(exact)) != 0)
+      return fail(err, errlen, "'%s': name too long for a temporary file", r->opt->output);
+    if (rewrite_exact(r, exact, err, errlen) != 0)
+      return -1;
+    done = exact;
+  }
+  if (rename(done, r->opt->output) != 0) {
+    remove(exact);
+    return fail(err, errlen, "cannot rename onto '%s': %s", r->opt->output, strerror(errno));
+  }
+  return 0;
+}
+
 int
 dacpo_tiled_orient(const dacpo_tiled_options* opt,
                    dacpo_tiled_report* rep,
@@ -603,6 +673,8 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
   if (rc == 0 && !(r.in = fopen(opt->input, "rb")))
     rc = fail(err, errlen, "cannot open '%s': %s", opt->input, strerror(errno));
   if (rc == 0)
+    rc = dacpo_ply_rows_set_origin(r.in, &r.rows, err, errlen) != 0;
+  if (rc == 0)
     rc = sample_and_plan(&r, err, errlen);
   rep->points = r.rows.n;
   rep->tiles = r.T;
@@ -637,10 +709,8 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
   if (rc == 0)
     rc = apply_flips(&r, flip, err, errlen);
   free(flip);
-  if (rc == 0 && fsync(r.out_fd) != 0)
-    rc = fail(err, errlen, "cannot write '%s': %s", r.out_tmp, strerror(errno));
-  if (rc == 0 && rename(r.out_tmp, opt->output) != 0)
-    rc = fail(err, errlen, "cannot rename onto '%s': %s", opt->output, strerror(errno));
+  if (rc == 0)
+    rc = finish_output(&r, err, errlen);
   rep->seconds[4] = now_s() - t0;
   run_cleanup(&r, rc == 0);
   return rc;

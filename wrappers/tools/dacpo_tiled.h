@@ -48,6 +48,16 @@ typedef struct dacpo_tiled_report {
 int
 dacpo_tiled_header(char* buf, size_t len, size_t tiles, uint64_t n);
 
+struct dacpo_ply_rows;
+/* The same with x y z of the input's types (rows; NULL: float), for outputs
+ * that keep the input's coordinates bit for bit. */
+int
+dacpo_tiled_header_typed(char* buf,
+                         size_t len,
+                         size_t tiles,
+                         uint64_t n,
+                         const struct dacpo_ply_rows* rows);
+
 /* The plan's sample: points whose input index is a multiple of this. */
 uint64_t
 dacpo_tiled_sample_stride(uint64_t n);

@@ -463,7 +463,9 @@ static int
 read_input(const options* o, dacpo_ply_cloud* cloud, dacpo_params* p)
 {
   char msg[512];
-  if (dacpo_points_read(o->in, cloud, msg, sizeof(msg)) != DACPO_PLY_OK) {
+  const int rc = dacpo_is_pcd_path(o->in) ? dacpo_points_read(o->in, cloud, msg, sizeof(msg))
+                                          : dacpo_ply_read_exact(o->in, cloud, msg, sizeof(msg));
+  if (rc != DACPO_PLY_OK) {
     fprintf(stderr, "Error: %s\n", msg);
     return 0;
   }
@@ -633,7 +635,7 @@ orient(const options* o,
 /* The output goes to a file beside the target first and is renamed over it
  * only when complete: a failed run never leaves half a file under its name. */
 static int
-write_output(const char* path, const dacpo_ply_cloud* cloud)
+write_output(const char* path, dacpo_ply_cloud* cloud)
 {
   char msg[512];
   const size_t len = strlen(path) + 64;
@@ -643,16 +645,18 @@ write_output(const char* path, const dacpo_ply_cloud* cloud)
     fprintf(stderr, "Error: '%s': name too long for a temporary file beside it\n", path);
   if (ok) {
     /* the format of the target's name, not of the temporary one */
-    int (*write)(
-        const char*, const float*, const float*, size_t, const char*, char*, size_t) =
-        dacpo_is_pcd_path(path) ? dacpo_pcd_write : dacpo_ply_write;
-    ok = write(tmp,
-               cloud->xyz,
-               cloud->normals,
-               cloud->n,
-               "pcl_dacpo_orient_mpi",
-               msg,
-               sizeof(msg)) == DACPO_PLY_OK;
+    const int pcd = dacpo_is_pcd_path(path);
+    /* coordinates float cannot hold: written back as read into PLY; a PCD
+       (float fields) gets the nearest floats, not the offsets computed on */
+    for (size_t i = 0; pcd && cloud->xyz_exact && i < 3 * cloud->n; ++i)
+      cloud->xyz[i] = (float)cloud->xyz_exact[i];
+    if (!pcd && cloud->xyz_exact)
+      ok = dacpo_ply_write_exact(tmp, cloud->xyz_exact, cloud->normals, cloud->n,
+                                 "pcl_dacpo_orient_mpi", msg, sizeof(msg)) == DACPO_PLY_OK;
+    else
+      ok = (pcd ? dacpo_pcd_write : dacpo_ply_write)(tmp, cloud->xyz, cloud->normals, cloud->n,
+                                                     "pcl_dacpo_orient_mpi", msg,
+                                                     sizeof(msg)) == DACPO_PLY_OK;
     if (!ok)
       fprintf(stderr, "Error: %s\n", msg);
     else if (rename(tmp, path) != 0) {
@@ -801,7 +805,8 @@ main(int argc, char** argv)
   double t = now();
   dacpo_ctx* ctx = NULL;
   dacpo_job* job = NULL;
-  dacpo_ply_cloud cloud = {0, NULL, NULL};
+  dacpo_ply_cloud cloud;
+  memset(&cloud, 0, sizeof(cloud));
   dacpo_params p = o.p;
   int ok = 1;
   if (rank == 0)
