@@ -31,14 +31,18 @@ ls -a "$W" | grep -q '^\.dacpo' && fail "temporary tile files were left behind"
 SAME_XYZ="$(dirname "$0")/same_xyz.py"
 "$MAKE" "$W/r.ply" -scene room -n 20000 -seed 2 > /dev/null
 "$MAKE" "$W/moved.ply" -scene room -n 20000 -seed 2 -offset 4e5,5e6,0 > /dev/null
+same_as_at_origin() { # label, suffix: r_SUFFIX.ply and moved_SUFFIX.ply written
+  python3 "$SAME_XYZ" "$W/moved.ply" "$W/moved_$2.ply" || fail "$1 changed double coordinates"
+  python3 "$SAME_XYZ" "$W/r.ply" "$W/r_$2.ply" || fail "$1 changed float coordinates"
+  local wr wm
+  wr=$(wrong "$W/r.ply" "$W/r_$2.ply"); wm=$(wrong "$W/moved.ply" "$W/moved_$2.ply")
+  awk -v a="$wr" -v b="$wm" 'BEGIN { d = a - b; exit !(d < 1 && d > -1) }' ||
+    fail "$1: the moved room $wm % wrong, at the origin $wr %"
+  echo "$1: coordinates kept bit for bit; moved room $wm % wrong, at the origin $wr %"
+}
 "$ORIENT" "$W/r.ply" "$W/r_t.ply" -tiles 2000 -seed 1 -q
 "$ORIENT" "$W/moved.ply" "$W/moved_t.ply" -tiles 2000 -seed 1 -q
-python3 "$SAME_XYZ" "$W/moved.ply" "$W/moved_t.ply" || fail "tiles changed double coordinates"
-python3 "$SAME_XYZ" "$W/r.ply" "$W/r_t.ply" || fail "tiles changed float coordinates"
-wr=$(wrong "$W/r.ply" "$W/r_t.ply"); wm=$(wrong "$W/moved.ply" "$W/moved_t.ply")
-awk -v a="$wr" -v b="$wm" 'BEGIN { d = a - b; exit !(d < 1 && d > -1) }' ||
-  fail "tiles: the moved room $wm % wrong, at the origin $wr %"
-echo "tiles: double coordinates kept bit for bit; moved room $wm % wrong, at the origin $wr %"
+same_as_at_origin tiles t
 
 # a cloud within the budget runs in core: the answer of a run without -tiles
 "$ORIENT" "$W/b.ply" "$W/fits.ply" -tiles 100000 -seed 1 -q
@@ -87,12 +91,7 @@ run 2 "$W/moved.ply" "$W/moved_mt.ply" -tiles 2000 -seed 1 -q
 cmp "$W/moved_t.ply" "$W/moved_mt.ply" || fail "mpi tiles of the moved room differ from one process"
 run 2 "$W/moved.ply" "$W/moved_mi.ply" -seed 1 -q
 run 2 "$W/r.ply" "$W/r_mi.ply" -seed 1 -q
-python3 "$SAME_XYZ" "$W/moved.ply" "$W/moved_mi.ply" || fail "mpi in core changed double coordinates"
-python3 "$SAME_XYZ" "$W/r.ply" "$W/r_mi.ply" || fail "mpi in core changed float coordinates"
-wr=$(wrong "$W/r.ply" "$W/r_mi.ply"); wm=$(wrong "$W/moved.ply" "$W/moved_mi.ply")
-awk -v a="$wr" -v b="$wm" 'BEGIN { d = a - b; exit !(d < 1 && d > -1) }' ||
-  fail "mpi in core: the moved room $wm % wrong, at the origin $wr %"
-echo "tiles: mpi keeps double coordinates (tiles and in core); moved room $wm % wrong, at the origin $wr %"
+same_as_at_origin "mpi in core" mi
 # with 3 ranks no rank holds all 40,000 points; together they hold every one
 held=$(sed -n 's/.*"held_points": \([0-9]*\).*/\1/p' "$W/mpi3.json")
 [ "$(wc -l <<< "$held")" -eq 3 ] || fail "the 3-rank report has not 3 lines"
