@@ -52,6 +52,11 @@
  * room for the halo. */
 #define DACPO_TILE_OWN_SHARE 0.8
 #define DACPO_TILE_MAX_TILES 65536
+/* Neighbours searched for the nearest sample at another position. */
+#define SPACING_K 16
+/* The own share is lowered at most to this share of max_points before an
+ * automatic halo is narrowed instead (tiles of mostly halo cost work). */
+#define DACPO_TILE_MIN_OWN_SHARE 0.25
 
 typedef struct tile_node {
   int axis;      /* -1: leaf */
@@ -145,6 +150,7 @@ plan_cell(plan_build* b, int32_t* idx, size_t n, int32_t* tmp)
   /* A cell of one repeated position cannot be cut: it stays one tile. */
   if (est <= b->cap || n < 2 || !(hi[axis] > lo[axis])) {
     b->node[id].axis = -1;
+    b->node[id].value = n < 2 || !(hi[axis] > lo[axis]); /* 1: cannot be cut */
     b->node[id].left = b->node[id].right = (int32_t)b->num_tiles++;
     return b->num_tiles > DACPO_TILE_MAX_TILES ? -2 : id;
   }
@@ -193,11 +199,17 @@ sample_spacing(const float* xyz, size_t m, uint64_t total, double* spacing, dacp
   dacpo_kdtree* tree = NULL;
   dacpo_status st = dacpo_kdtree_build(p, m, &tree, err);
   size_t nd = 0;
+  /* the nearest sample at another position: copies of a point (a scan
+     concatenated twice) are at distance 0 and say nothing of the spacing */
   for (size_t i = 0; st == DACPO_OK && i < m; ++i) {
-    int32_t id[2];
-    double sq[2];
-    if (dacpo_kdtree_knn(tree, p + 3 * i, 2, id, sq) == 2 && sq[1] > 0.0)
-      d[nd++] = sqrt(sq[1]);
+    int32_t id[SPACING_K];
+    double sq[SPACING_K];
+    const size_t got = dacpo_kdtree_knn(tree, p + 3 * i, SPACING_K, id, sq);
+    for (size_t j = 1; j < got; ++j)
+      if (sq[j] > 0.0) {
+        d[nd++] = sqrt(sq[j]);
+        break;
+      }
   }
   if (st == DACPO_OK && nd > 0)
     *spacing = dacpo_select_kth(d, nd, nd / 2) * sqrt((double)m / (double)total);
@@ -231,6 +243,112 @@ locate_node(const dacpo_tile_plan* plan,
     locate_node(plan, nd->left, p, skip, tiles, max_tiles, count);
   if (nd->value - v <= plan->halo)
     locate_node(plan, nd->right, p, skip, tiles, max_tiles, count);
+}
+
+/* The cells for own points of at most cap (plan_cell), in plan->node. */
+static dacpo_status
+plan_cells(dacpo_tile_plan* plan,
+           const float* sample,
+           size_t m,
+           uint64_t total,
+           double cap,
+           uint64_t max_points,
+           int32_t* tmp,
+           dacpo_err* err)
+{
+  plan_build b;
+  memset(&b, 0, sizeof(b));
+  b.xyz = sample;
+  b.total = total;
+  b.m = m;
+  b.cap = cap;
+  b.idx = dacpo_malloc_array(m, sizeof(int32_t));
+  if (!b.idx)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < m; ++i)
+    b.idx[i] = (int32_t)i;
+  const int32_t root = plan_cell(&b, b.idx, m, tmp);
+  free(b.idx);
+  free(plan->node);
+  plan->node = b.node;
+  plan->num_nodes = b.num_nodes;
+  plan->num_tiles = b.num_tiles;
+  if (root == -1)
+    return DACPO_OOM(err);
+  if (root == -2)
+    return dacpo_err_set(err,
+                         DACPO_ERR_INVALID_ARGUMENT,
+                         "tile plan: more than %d tiles (max_points %llu is too small "
+                         "for %llu points)",
+                         DACPO_TILE_MAX_TILES,
+                         (unsigned long long)max_points,
+                         (unsigned long long)total);
+  return DACPO_OK;
+}
+
+/* Own + halo points per tile from the sample, scaled to the total; the
+ * largest over tiles that could still be cut. */
+static dacpo_status
+plan_estimates(dacpo_tile_plan* plan,
+               const float* sample,
+               size_t m,
+               uint64_t total,
+               int32_t* tmp,
+               uint64_t* worst,
+               dacpo_err* err)
+{
+  free(plan->estimate);
+  plan->estimate = calloc(plan->num_tiles, sizeof(uint64_t));
+  if (!plan->estimate)
+    return DACPO_OOM(err);
+  for (size_t i = 0; i < m; ++i) {
+    size_t c = 0;
+    locate_node(plan, 0, sample + 3 * i, -1, tmp, m, &c);
+    for (size_t t = 0; t < c && t < m; ++t)
+      plan->estimate[tmp[t]]++;
+  }
+  for (size_t t = 0; t < plan->num_tiles; ++t)
+    plan->estimate[t] = (uint64_t)((double)plan->estimate[t] * (double)total / (double)m + 0.5);
+  *worst = 0;
+  for (size_t id = 0; id < plan->num_nodes; ++id) {
+    const tile_node* nd = &plan->node[id];
+    if (nd->axis < 0 && nd->value == 0.0 && plan->estimate[nd->left] > *worst)
+      *worst = plan->estimate[nd->left];
+  }
+  return DACPO_OK;
+}
+
+/* Cells whose own + halo points fit max_points: the own share starts at
+ * DACPO_TILE_OWN_SHARE and shrinks with the worst tile's excess; below
+ * DACPO_TILE_MIN_OWN_SHARE an automatic halo narrows instead. A cell of one
+ * repeated position cannot be cut and may stay larger. */
+static dacpo_status
+plan_fit(dacpo_tile_plan* plan,
+         const float* sample,
+         size_t m,
+         uint64_t total,
+         uint64_t max_points,
+         int halo_given,
+         int32_t* tmp,
+         dacpo_err* err)
+{
+  double cap = DACPO_TILE_OWN_SHARE * (double)max_points;
+  dacpo_status st = DACPO_OK;
+  for (int round = 0; st == DACPO_OK && round < 64; ++round) {
+    uint64_t worst = 0;
+    st = plan_cells(plan, sample, m, total, cap, max_points, tmp, err);
+    if (st == DACPO_OK)
+      st = plan_estimates(plan, sample, m, total, tmp, &worst, err);
+    if (st != DACPO_OK || worst <= max_points || cap < 16.0)
+      break;
+    const double shrink = 0.95 * (double)max_points / (double)worst;
+    cap *= shrink > 0.5 ? shrink : 0.5;
+    if (!halo_given && cap < DACPO_TILE_MIN_OWN_SHARE * (double)max_points) {
+      cap = DACPO_TILE_MIN_OWN_SHARE * (double)max_points;
+      plan->halo *= 0.75;
+    }
+  }
+  return st;
 }
 
 static dacpo_status
@@ -269,60 +387,15 @@ tile_plan_create(const float* sample,
                 "tile plan: sample point %zu is not finite",
                 i / 3);
   dacpo_tile_plan* plan = calloc(1, sizeof(*plan));
-  plan_build b;
-  memset(&b, 0, sizeof(b));
-  b.xyz = sample;
-  b.total = total;
-  b.m = m;
-  b.cap = DACPO_TILE_OWN_SHARE * (double)max_points;
-  b.idx = dacpo_malloc_array(m, sizeof(int32_t));
   int32_t* tmp = dacpo_malloc_array(m, sizeof(int32_t));
-  dacpo_status st = plan && b.idx && tmp ? DACPO_OK : DACPO_OOM(err);
+  double spacing = 0.0;
+  dacpo_status st = plan && tmp ? DACPO_OK : DACPO_OOM(err);
+  if (st == DACPO_OK && !(halo > 0.0))
+    st = sample_spacing(sample, m, total, &spacing, err);
   if (st == DACPO_OK) {
-    for (size_t i = 0; i < m; ++i)
-      b.idx[i] = (int32_t)i;
-    const int32_t root = plan_cell(&b, b.idx, m, tmp);
-    if (root == -1)
-      st = DACPO_OOM(err);
-    else if (root == -2)
-      st = dacpo_err_set(err,
-                         DACPO_ERR_INVALID_ARGUMENT,
-                         "tile plan: more than %d tiles (max_points %llu is too small "
-                         "for %llu points)",
-                         DACPO_TILE_MAX_TILES,
-                         (unsigned long long)max_points,
-                         (unsigned long long)total);
+    plan->halo = halo > 0.0 ? halo : DACPO_TILE_HALO_SPACINGS * spacing;
+    st = plan_fit(plan, sample, m, total, max_points, halo > 0.0, tmp, err);
   }
-  if (st == DACPO_OK) {
-    plan->node = b.node;
-    plan->num_nodes = b.num_nodes;
-    plan->num_tiles = b.num_tiles;
-    b.node = NULL;
-    double spacing = 0.0;
-    if (halo > 0.0)
-      plan->halo = halo;
-    else if ((st = sample_spacing(sample, m, total, &spacing, err)) == DACPO_OK)
-      plan->halo = DACPO_TILE_HALO_SPACINGS * spacing;
-  }
-  if (st == DACPO_OK) {
-    plan->estimate = calloc(plan->num_tiles, sizeof(uint64_t));
-    if (!plan->estimate)
-      st = DACPO_OOM(err);
-  }
-  if (st == DACPO_OK) {
-    /* sample counts per tile (own + halo), scaled to the total */
-    const size_t nt = plan->num_tiles;
-    for (size_t i = 0; i < m; ++i) {
-      size_t c = 0;
-      locate_node(plan, 0, sample + 3 * i, -1, tmp, m, &c);
-      for (size_t t = 0; t < c && t < m; ++t)
-        plan->estimate[tmp[t]]++;
-    }
-    for (size_t t = 0; t < nt; ++t)
-      plan->estimate[t] = (uint64_t)((double)plan->estimate[t] * (double)total / (double)m + 0.5);
-  }
-  free(b.node);
-  free(b.idx);
   free(tmp);
   if (st != DACPO_OK) {
     dacpo_tile_plan_free(plan);
