@@ -150,7 +150,6 @@ plan_cell(plan_build* b, int32_t* idx, size_t n, int32_t* tmp)
   /* A cell of one repeated position cannot be cut: it stays one tile. */
   if (est <= b->cap || n < 2 || !(hi[axis] > lo[axis])) {
     b->node[id].axis = -1;
-    b->node[id].value = n < 2 || !(hi[axis] > lo[axis]); /* 1: cannot be cut */
     b->node[id].left = b->node[id].right = (int32_t)b->num_tiles++;
     return b->num_tiles > DACPO_TILE_MAX_TILES ? -2 : id;
   }
@@ -286,15 +285,13 @@ plan_cells(dacpo_tile_plan* plan,
   return DACPO_OK;
 }
 
-/* Own + halo points per tile from the sample, scaled to the total; the
- * largest over tiles that could still be cut. */
+/* Own + halo points per tile from the sample, scaled to the total. */
 static dacpo_status
 plan_estimates(dacpo_tile_plan* plan,
                const float* sample,
                size_t m,
                uint64_t total,
                int32_t* tmp,
-               uint64_t* worst,
                dacpo_err* err)
 {
   free(plan->estimate);
@@ -309,46 +306,7 @@ plan_estimates(dacpo_tile_plan* plan,
   }
   for (size_t t = 0; t < plan->num_tiles; ++t)
     plan->estimate[t] = (uint64_t)((double)plan->estimate[t] * (double)total / (double)m + 0.5);
-  *worst = 0;
-  for (size_t id = 0; id < plan->num_nodes; ++id) {
-    const tile_node* nd = &plan->node[id];
-    if (nd->axis < 0 && nd->value == 0.0 && plan->estimate[nd->left] > *worst)
-      *worst = plan->estimate[nd->left];
-  }
   return DACPO_OK;
-}
-
-/* Cells whose own + halo points fit max_points: the own share starts at
- * DACPO_TILE_OWN_SHARE and shrinks with the worst tile's excess; below
- * DACPO_TILE_MIN_OWN_SHARE an automatic halo narrows instead. A cell of one
- * repeated position cannot be cut and may stay larger. */
-static dacpo_status
-plan_fit(dacpo_tile_plan* plan,
-         const float* sample,
-         size_t m,
-         uint64_t total,
-         uint64_t max_points,
-         int halo_given,
-         int32_t* tmp,
-         dacpo_err* err)
-{
-  double cap = DACPO_TILE_OWN_SHARE * (double)max_points;
-  dacpo_status st = DACPO_OK;
-  for (int round = 0; st == DACPO_OK && round < 64; ++round) {
-    uint64_t worst = 0;
-    st = plan_cells(plan, sample, m, total, cap, max_points, tmp, err);
-    if (st == DACPO_OK)
-      st = plan_estimates(plan, sample, m, total, tmp, &worst, err);
-    if (st != DACPO_OK || worst <= max_points || cap < 16.0)
-      break;
-    const double shrink = 0.95 * (double)max_points / (double)worst;
-    cap *= shrink > 0.5 ? shrink : 0.5;
-    if (!halo_given && cap < DACPO_TILE_MIN_OWN_SHARE * (double)max_points) {
-      cap = DACPO_TILE_MIN_OWN_SHARE * (double)max_points;
-      plan->halo *= 0.75;
-    }
-  }
-  return st;
 }
 
 static dacpo_status
@@ -394,8 +352,11 @@ tile_plan_create(const float* sample,
     st = sample_spacing(sample, m, total, &spacing, err);
   if (st == DACPO_OK) {
     plan->halo = halo > 0.0 ? halo : DACPO_TILE_HALO_SPACINGS * spacing;
-    st = plan_fit(plan, sample, m, total, max_points, halo > 0.0, tmp, err);
+    st = plan_cells(
+        plan, sample, m, total, DACPO_TILE_OWN_SHARE * (double)max_points, max_points, tmp, err);
   }
+  if (st == DACPO_OK)
+    st = plan_estimates(plan, sample, m, total, tmp, err);
   free(tmp);
   if (st != DACPO_OK) {
     dacpo_tile_plan_free(plan);

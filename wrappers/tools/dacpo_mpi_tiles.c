@@ -29,6 +29,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "dacpo_mpi_tiles.h"
+#include "dacpo_cleanup.h"
 #include "dacpo_paths.h"
 
 #include "dacpo_ply.h"
@@ -582,11 +583,13 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
   const int hlen = dacpo_tiled_header_typed(header, sizeof(header), t->T, t->n, &t->rows);
   const size_t xb = dacpo_ply_rows_xyz_bytes(&t->rows), row = xb + 12;
   MPI_File fh;
+  const int slot = dacpo_cleanup_add(tmp);
   ok = MPI_File_open(MPI_COMM_WORLD, tmp, MPI_MODE_CREATE | MPI_MODE_WRONLY, MPI_INFO_NULL, &fh) ==
        MPI_SUCCESS;
   if (!dacpo_mpi_all_ok(ok)) {
     if (t->rank == 0)
       fprintf(stderr, "Error: cannot create '%s'\n", tmp);
+    dacpo_cleanup_drop(slot);
     return 0;
   }
   /* the whole size is allocated on disk first (not a sparse set_size): a full
@@ -630,6 +633,7 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
     if (!ok)
       remove(tmp);
   }
+  dacpo_cleanup_drop(slot);
   return dacpo_mpi_all_ok(ok);
 }
 

@@ -22,6 +22,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "dacpo_tiled.h"
+#include "dacpo_cleanup.h"
 #include "dacpo_paths.h"
 
 #include "dacpo_ply.h"
@@ -150,6 +151,7 @@ typedef struct tiled_run {
   long header_len;
   FILE* halo_file;
   float* chunk;
+  int cleanup[3]; /* dacpo_cleanup slots: tile series, halo file, output temp */
 } tiled_run;
 
 static void
@@ -162,6 +164,8 @@ static void
 run_cleanup(tiled_run* r, int keep_output)
 {
   char path[4200];
+  for (int i = 0; i < 3; ++i)
+    dacpo_cleanup_drop(r->cleanup[i]);
   if (r->tile_file)
     for (size_t t = 0; t < r->T; ++t) {
       if (r->tile_file[t])
@@ -324,6 +328,7 @@ create_output(tiled_run* r, char* err, size_t errlen)
   if (dacpo_temp_sibling(r->opt->output, "tmp", (long)getpid(), r->out_tmp, sizeof(r->out_tmp)) != 0)
     return fail(err, errlen, "'%s': name too long for a temporary file beside it",
                 r->opt->output);
+  r->cleanup[2] = dacpo_cleanup_add(r->out_tmp);
   r->out_fd = open(r->out_tmp, O_RDWR | O_CREAT | O_TRUNC, 0644);
   if (r->out_fd < 0)
     return fail(err, errlen, "cannot create '%s': %s", r->out_tmp, strerror(errno));
@@ -605,19 +610,26 @@ finish_output(tiled_run* r, char* err, size_t errlen)
 {
   const char* done = r->out_tmp;
   char exact[4200];
+  int slot = -1;
   if (fsync(r->out_fd) != 0)
     return fail(err, errlen, "cannot write '%s': %s", r->out_tmp, strerror(errno));
   if (!dacpo_ply_rows_exact_in_float(&r->rows)) {
     if (dacpo_temp_sibling(r->opt->output, "exact", (long)getpid(), exact, sizeof(exact)) != 0)
       return fail(err, errlen, "'%s': name too long for a temporary file", r->opt->output);
-    if (rewrite_exact(r, exact, err, errlen) != 0)
+    slot = dacpo_cleanup_add(exact);
+    if (rewrite_exact(r, exact, err, errlen) != 0) {
+      dacpo_cleanup_drop(slot);
       return -1;
+    }
     done = exact;
   }
-  if (rename(done, r->opt->output) != 0) {
-    remove(exact);
-    return fail(err, errlen, "cannot rename onto '%s': %s", r->opt->output, strerror(errno));
-  }
+  const int renamed = rename(done, r->opt->output) == 0;
+  const int saved = errno;
+  if (slot >= 0) /* the float file is done with; the exact one if not renamed */
+    remove(renamed ? r->out_tmp : exact);
+  dacpo_cleanup_drop(slot);
+  if (!renamed)
+    return fail(err, errlen, "cannot rename onto '%s': %s", r->opt->output, strerror(saved));
   return 0;
 }
 
@@ -639,6 +651,7 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
   memset(&r, 0, sizeof(r));
   r.opt = opt;
   r.out_fd = -1;
+  r.cleanup[0] = r.cleanup[1] = r.cleanup[2] = -1;
   r.chunk = malloc(3 * (size_t)TILED_CHUNK * sizeof(float) * 2);
   if (!r.chunk)
     return fail(err, errlen, "out of memory");
@@ -682,11 +695,14 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
   double t1 = now_s();
   rep->seconds[0] = t1 - t0;
   if (rc == 0)
+    r.cleanup[0] = dacpo_cleanup_add_series(r.tmp_prefix, r.T);
+  if (rc == 0)
     rc = route(&r, rep, err, errlen);
   if (rc == 0)
     rc = create_output(&r, err, errlen);
   char path[4200];
   snprintf(path, sizeof(path), "%s.halo", r.tmp_prefix);
+  r.cleanup[1] = dacpo_cleanup_add(path);
   if (rc == 0 && !(r.halo_file = fopen(path, "w+b")))
     rc = fail(err, errlen, "cannot create '%s': %s", path, strerror(errno));
   t0 = now_s();

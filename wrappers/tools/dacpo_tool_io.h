@@ -4,6 +4,7 @@
  * parsing of options. Header-only, tools only (not installed). */
 #pragma once
 
+#include "dacpo_cleanup.h"
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
@@ -1282,12 +1283,17 @@ writeAtomically(const std::string& path, Produce produce, std::string& error)
   const std::string tmp = dir + "." + base + ".tmp" +
                           std::to_string(static_cast<long>(::getpid())) +
                           extension(path);
+  /* a SIGINT or SIGTERM while it is written removes it (dacpo_cleanup.h) */
+  const int slot = dacpo_cleanup_add(tmp.c_str());
   const bool ok = produce(tmp, error) && syncFile(tmp, error);
-  if (ok && std::rename(tmp.c_str(), path.c_str()) == 0)
+  if (ok && std::rename(tmp.c_str(), path.c_str()) == 0) {
+    dacpo_cleanup_drop(slot);
     return true;
+  }
   if (ok)
     error = ioError("cannot replace", path);
   std::remove(tmp.c_str());
+  dacpo_cleanup_drop(slot);
   return false;
 }
 

@@ -732,6 +732,7 @@ printText(const std::string& file, const EvalScores& s)
 int
 main(int argc, char** argv)
 {
+  dacpo_cleanup_install(); /* temporary files go with SIGINT / SIGTERM */
   EvalOptions options;
   int exit_code = 1;
   if (!parseEvalOptions(argc, argv, options, exit_code))

@@ -249,8 +249,10 @@ const OptionSpec kOptions[] = {
      }},
     {"-tiles",
      "P",
-     "out of core with tiles of at most P points (own +\n"
-     "halo) instead of a -memory budget",
+     "out of core with tiles of about 0.8 P own points\n"
+     "instead of a -memory budget; each tile also reads its\n"
+     "halo (16 spacings around it: up to ~3 P in all for\n"
+     "small P), reported as largest_tile",
      nullptr,
      [](Options& o, const std::string& s, std::string& error) {
        if (!toUnsigned(s, o.tile_points) || o.tile_points < 16) {
@@ -1330,6 +1332,7 @@ orientDirectory(const Options& options)
 int
 main(int argc, char** argv)
 {
+  dacpo_cleanup_install(); /* temporary files go with SIGINT / SIGTERM */
   const bool help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
   if (argc < 3 || help) {
     print_info("Orient normals with DACPO. For more information, use: %s -h\n",

@@ -46,6 +46,7 @@
 #include "dacpo_mpi_knn.h"
 #include "dacpo_mpi_tiles.h"
 #include "dacpo_tiled.h"
+#include "dacpo_cleanup.h"
 #include "dacpo_paths.h"
 #include "dacpo_pcd.h"
 #include <sys/resource.h>
@@ -643,6 +644,7 @@ write_output(const char* path, dacpo_ply_cloud* cloud)
   int ok = tmp != NULL && dacpo_temp_sibling(path, "tmp", (long)getpid(), tmp, len) == 0;
   if (tmp && !ok)
     fprintf(stderr, "Error: '%s': name too long for a temporary file beside it\n", path);
+  const int slot = ok ? dacpo_cleanup_add(tmp) : -1;
   if (ok) {
     /* the format of the target's name, not of the temporary one */
     const int pcd = dacpo_is_pcd_path(path);
@@ -667,6 +669,7 @@ write_output(const char* path, dacpo_ply_cloud* cloud)
     if (!ok)
       remove(tmp);
   }
+  dacpo_cleanup_drop(slot);
   free(tmp);
   return ok;
 }
@@ -780,6 +783,7 @@ int
 main(int argc, char** argv)
 {
   MPI_Init(&argc, &argv);
+  dacpo_cleanup_install();
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
