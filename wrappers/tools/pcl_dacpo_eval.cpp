@@ -363,20 +363,6 @@ saveColored(const std::string& path,
   return true;
 }
 
-/* Sets the options of kEvalOptions as PCL's parse_argument and find_switch
- * read them: the first occurrence counts, a value option at the very end is
- * left unset (checkArguments has rejected unknown options before). */
-void
-applyEvalOptions(int argc, char** argv, EvalOptions& o)
-{
-  for (const EvalOptionSpec& spec : kEvalOptions) {
-    std::string value, unused;
-    if (spec.arg ? parse_argument(argc, argv, spec.name, value) >= 0
-                 : find_switch(argc, argv, spec.name))
-      spec.apply(o, value, unused);
-  }
-}
-
 /* Reads and checks the command line; false: exit with *exit_code (help, or a
  * message was printed). */
 bool
@@ -402,7 +388,9 @@ parseEvalOptions(int argc, char** argv, EvalOptions& o, int& exit_code)
     printHelp(argc, argv);
     return false;
   }
-  applyEvalOptions(argc, argv, o);
+  /* in command-line order; an option missing its value is an error */
+  if (!dacpo_tool::applyOptions(kEvalOptions, argc, argv, o))
+    return false;
   if (!o.normals_colored.empty() &&
       dacpo_tool::extension(o.normals_colored) != ".pcd" &&
       dacpo_tool::extension(o.normals_colored) != ".ply") {
