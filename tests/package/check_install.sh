@@ -52,6 +52,21 @@ cmake -S "$app" -B "$app/build" -DCMAKE_PREFIX_PATH="$prefix" >"$app/cfg.log" 2>
 cmake --build "$app/build" >"$app/build.log" 2>&1 ||
   fail "C++-only app: build failed: $(grep -E 'error|undefined' "$app/build.log" | head -10)"
 
+# 2b. relocatable: the installed tools and the outside app run from this
+#     prefix with no LD_LIBRARY_PATH (RUNPATH $ORIGIN/../lib, not /usr/local/lib)
+for lib in "$prefix"/lib/libdacpo.so.0 "$prefix"/lib/libpcl_dacpo.so.0 "$prefix/bin/pcl_dacpo_orient"; do
+  [ -e "$lib" ] || continue
+  readelf -d "$lib" | grep -q 'R.*PATH.*\$ORIGIN' || fail "$lib: no \$ORIGIN in its RUNPATH"
+done
+if [ -x "$prefix/bin/pcl_dacpo_orient" ]; then
+  env -u LD_LIBRARY_PATH "$prefix/bin/dacpo_make_scene" "$work/box.pcd" -scene box -n 3000 \
+    >"$work/tool.log" 2>&1 || fail "the installed dacpo_make_scene does not run"
+  env -u LD_LIBRARY_PATH "$prefix/bin/pcl_dacpo_orient" "$work/box.pcd" "$work/box_o.pcd" -q \
+    >>"$work/tool.log" 2>&1 || fail "the installed pcl_dacpo_orient does not run: $(tail -3 "$work/tool.log")"
+  env -u LD_LIBRARY_PATH "$app/build/my_app" "$work/box.pcd" "$work/box_app.pcd" \
+    >>"$work/tool.log" 2>&1 || fail "the outside app does not run: $(tail -3 "$work/tool.log")"
+fi
+
 # 3. the C core with pkg-config alone
 PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --exists dacpo || fail "pkg-config does not find dacpo"
 # shellcheck disable=SC2046

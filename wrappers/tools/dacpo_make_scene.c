@@ -13,6 +13,7 @@
  * Exit status: 0 on success, 1 for bad arguments, 2 when generation or writing
  * fails.
  */
+#include "dacpo_pcd.h"
 #include "dacpo_ply.h"
 #include "dacpo_scene.h"
 
@@ -22,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 
 /* Binary little-endian PLY with double x y z (x scale + offset) and float
@@ -59,9 +61,9 @@ print_help(const char* prog)
 {
   dacpo_scene_params d;
   dacpo_scene_params_init(&d);
-  printf("Write a synthetic scene with ground-truth normals as binary PLY "
-         "(float x y z nx ny nz).\n\n");
-  printf("Usage: %s out.ply <options>\n\nOptions:\n", prog);
+  printf("Write a synthetic scene with ground-truth normals as binary PLY or PCD "
+         "by the output's\nextension (float x y z nx ny nz).\n\n");
+  printf("Usage: %s out.ply|out.pcd <options>\n\nOptions:\n", prog);
   printf("  -scene NAME      scene kind (default: %s); one of:\n",
          dacpo_scene_kind_name(d.kind));
   printf("                     ");
@@ -242,6 +244,14 @@ parse_args(int argc, char** argv, const char* prog, make_options* o)
   }
   if (!o->out_path)
     return usage_error(prog, "no output file given", NULL);
+  /* the format follows the name: a PLY under a .pcd name crashed PCL readers */
+  const size_t len = strlen(o->out_path);
+  const int ply = len >= 4 && strcasecmp(o->out_path + len - 4, ".ply") == 0;
+  if (!ply && !dacpo_is_pcd_path(o->out_path))
+    return usage_error(prog, "the output must end in .ply or .pcd:", o->out_path);
+  if (!ply && o->use_offset)
+    return usage_error(prog, "-offset / -scale write double x y z: use a .ply name, not",
+                       o->out_path);
   if (o->p.downsample_to > o->p.target_points) {
     fprintf(stderr,
             "%s: -downsample %zu is larger than -n %zu\n",
@@ -275,7 +285,7 @@ write_scene(const char* prog, const make_options* o, const dacpo_scene* scene)
                                        o->scale,
                                        o->offset,
                                        "moved (dacpo_make_scene -scale/-offset)") != 0
-                    : dacpo_ply_write(o->out_path,
+                    : dacpo_points_write(o->out_path,
                                       scene->xyz,
                                       scene->normals,
                                       scene->n,
