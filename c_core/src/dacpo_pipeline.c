@@ -1165,8 +1165,13 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
       if (st->layered_share >= DACPO_LAYERED_SHARE ||
           st->layered_copies >= DACPO_LAYERED_COPIES)
         s->p.dipole_sides = 0.0;
-      if (st->layered_copies >= DACPO_LAYERED_COPIES)
+      /* copies are layers of one surface seen from one side: c = 1 as for a
+       * single view (Eq. 1's stacked vote reads them as opposite faces) */
+      if (st->layered_copies >= DACPO_LAYERED_COPIES) {
         s->p.dipole_two_sheet = 0.0;
+        if (s->p.dipole_c < 0.0)
+          s->p.dipole_c = 1.0;
+      }
     }
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;

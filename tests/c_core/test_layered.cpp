@@ -145,8 +145,8 @@ TEST(DacpoLayered, BadArgumentsAndTinyClouds)
 // Through the pipeline: AUTO finds the copies and leaves the side cue out;
 // given MULTI_VIEW keeps it, the copies then face away from each other and the
 // cue's anchors turn whole blocks. Measured (run seed 1, 100K points, scene
-// seed 2): AUTO 7.11 % (copy rate 0.069: the two-sheet rule goes too; 5.65 %
-// with it), MULTI_VIEW 30.83 %. (At 60K points, 2.1 cm spacing,
+// seed 2): AUTO 7.14 % (copy rate 0.069: the two-sheet rule goes too and c
+// is 1; 7.11 % at c = 1.5, 5.65 % with the two-sheet rule), MULTI_VIEW 30.83 %. (At 60K points, 2.1 cm spacing,
 // the same copies hardly fire the cue: 6.56 % against 4.68 %.)
 TEST(DacpoLayered, PipelineLeavesTheCueOutOnFusedRooms)
 {

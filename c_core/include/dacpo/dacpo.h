@@ -155,7 +155,8 @@ typedef struct dacpo_params {
                              n/625 clamped to [1, 400] (default 0) */
   size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
   double dipole_c;      /**< c of paper Eq. 1 (-1: by the scan kind, 1 for a single
-                             depth view, 1.5 otherwise; values >= 1). The paper
+                             depth view or a scan of offset copies, 1.5
+                             otherwise; values >= 1). The paper
                              uses 4 for clean and 2 for noisy scans. Larger c
                              keeps the two sides of thin structures apart, smaller
                              c resists depth noise; c = 1 leaves only the

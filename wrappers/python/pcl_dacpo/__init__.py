@@ -167,7 +167,7 @@ def orient(points, normals=None, *, progress=None, **params):
               cancels too (KeyboardInterrupt).
     params:   any ``dacpo_params`` field with the C default (``default_params()``
               lists them): ``k=10``, ``seed=1``, ``threads=0`` (all cores),
-              ``num_blocks=0`` (automatic), ``dipole_c=1.5``,
+              ``num_blocks=0`` (automatic), ``dipole_c=-1`` (by the scan kind),
               ``edge_weight='vcr'``, ``sign_policy='free_space'``,
               ``scan_kind='auto'`` (or ``'single_view'``, ``'multi_view'``),
               ``viewpoint=(x, y, z)`` (then normals face it), ...
