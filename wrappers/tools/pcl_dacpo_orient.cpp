@@ -559,13 +559,25 @@ loadCloud(const std::string& filename, pcl::PCLPointCloud2& cloud)
   return true;
 }
 
-/* Progress on one terminal line, shown once a run has taken more than a second:
- * "\r  ipsr          42%  elapsed 3.1 s  stage left ~4.2 s". The time left is
- * extrapolated from the stage's own progress. */
+/* Stages 2 and 3 run in one pass over the blocks (reported as ipsr, or as
+ * dipole when iPSR is off): name them both. */
+const char*
+progressName(dacpo_stage stage)
+{
+  return stage == DACPO_STAGE_IPSR ? "dipole+ipsr" : dacpo_stage_name(stage);
+}
+
+/* Progress to stderr, shown once a run has taken more than a second. On a
+ * terminal one line rewritten in place: "\r  dipole+ipsr   42%  elapsed 3.1 s
+ * stage left ~4.2 s" (the time left extrapolated from the stage's progress);
+ * in a pipe or a log a line per stage and every few seconds. */
 struct ProgressLine {
   using Clock = std::chrono::steady_clock;
+  static constexpr double kLogEvery = 5.0; /* seconds between lines in a log */
+  bool tty = true;
   Clock::time_point start = Clock::now();
   Clock::time_point stage_start = start;
+  double last_line = -kLogEvery;
   int last_stage = -1;
   int last_percent = -1;
   bool shown = false;
@@ -573,32 +585,29 @@ struct ProgressLine {
   operator()(dacpo_stage stage, double fraction)
   {
     const Clock::time_point now = Clock::now();
-    if (static_cast<int>(stage) != last_stage)
+    const bool new_stage = static_cast<int>(stage) != last_stage;
+    if (new_stage)
       stage_start = now;
     const int percent = static_cast<int>(fraction * 100.0 + 0.5);
     const double elapsed = std::chrono::duration<double>(now - start).count();
     const double in_stage = std::chrono::duration<double>(now - stage_start).count();
-    if ((static_cast<int>(stage) == last_stage && percent == last_percent) ||
-        (!shown && elapsed < 1.0)) {
-      last_stage = static_cast<int>(stage);
-      return true;
-    }
+    const bool due = tty ? !(!new_stage && percent == last_percent)
+                         : new_stage || elapsed - last_line >= kLogEvery;
     last_stage = static_cast<int>(stage);
+    if (!due || (!shown && elapsed < 1.0))
+      return true;
     last_percent = percent;
+    last_line = elapsed;
     shown = true;
+    char left[48] = "";
     if (fraction > 0.02 && fraction < 1.0)
-      std::fprintf(stderr,
-                   "\r  %-12s %3d%%  elapsed %.1f s  stage left ~%.1f s   ",
-                   dacpo_stage_name(stage),
-                   percent,
-                   elapsed,
-                   in_stage * (1.0 - fraction) / fraction);
-    else
-      std::fprintf(stderr,
-                   "\r  %-12s %3d%%  elapsed %.1f s                    ",
-                   dacpo_stage_name(stage),
-                   percent,
-                   elapsed);
+      std::snprintf(left, sizeof(left), "  stage left ~%.1f s", in_stage * (1.0 - fraction) / fraction);
+    std::fprintf(stderr,
+                 tty ? "\r  %-12s %3d%%  elapsed %.1f s%-22s" : "progress: %s %d%% elapsed %.1f s%s\n",
+                 progressName(stage),
+                 percent,
+                 elapsed,
+                 left);
     std::fflush(stderr);
     return true;
   }
@@ -797,7 +806,8 @@ compute(const pcl::PCLPointCloud2& input,
   chooseNormals(input, options, n, dacpo);
 
   ProgressLine line;
-  const bool show_progress = !options.quiet && isatty(2);
+  line.tty = isatty(2) != 0;
+  const bool show_progress = !options.quiet;
   if (show_progress)
     dacpo.setProgressCallback(std::ref(line));
 
@@ -805,7 +815,7 @@ compute(const pcl::PCLPointCloud2& input,
   tt.tic();
   pcl::PointCloud<pcl::Normal> normals_out;
   dacpo.compute(normals_out);
-  if (show_progress)
+  if (show_progress && line.tty && line.shown)
     std::fprintf(stderr, "\r%78s\r", "");
   if (normals_out.size() != n) {
     print_error("Error: orientation failed: %s: %s\n",
