@@ -12,6 +12,7 @@ PACKAGES=(
   pcl-tools           # pcl_viewer for looking at results
   clang               # libFuzzer targets (scripts/fuzz.sh, part of the test command)
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python package and its tests
+  python3-venv python3-pip python3-setuptools   # pip install . (pyproject.toml, its test)
   openmpi-bin libopenmpi-dev   # pcl_dacpo_orient_mpi and its test (mpirun -np 2, 3)
 )
 

@@ -75,7 +75,8 @@ cc -std=c11 -o "$work/minimal_pc" "$doc/samples/c/orient_minimal.c" \
   fail "compiling with pkg-config flags failed"
 "$work/minimal_pc" >"$work/minimal_pc.log" 2>&1 || fail "the pkg-config build does not run"
 # 4. the Python package, when it was built: importable from the prefix alone
-py="$prefix/lib/python3/dist-packages"
+py=$(ls -d "$prefix"/lib/python3.*/*-packages 2>/dev/null | head -1)
+py="${py:-$prefix/lib/python3/dist-packages}"
 if [ -d "$py/pcl_dacpo" ]; then
   (cd "$work" && PYTHONPATH="$py" /usr/bin/python3 -c "
 import pcl_dacpo, numpy as np
