@@ -131,6 +131,9 @@ def _check_params(params):
 
 
 def _as_points(points, name):
+    if hasattr(points, "has_normals") and hasattr(points, "points"):
+        raise TypeError(f"{name} is an open3d.geometry.PointCloud: use "
+                        "pcl_dacpo.orient_o3d(pcd), which orients its normals in place")
     a = _np.asarray(points)
     if a.ndim != 2 or a.shape[1] != 3:
         raise ValueError(f"{name} must have shape (N, 3), got {a.shape}")
@@ -173,7 +176,8 @@ def orient(points, normals=None, *, progress=None, **params):
               ``viewpoint=(x, y, z)`` (then normals face it), ...
 
     Returns an (N, 3) float32 array of unit normals in the input order and an
-    ``OrientResult``. Unknown parameters raise TypeError, bad values
+    ``OrientResult``; rows whose point has a NaN or inf coordinate get NaN
+    normals (labels -1, confidence NaN), as in the PCL class and the CLI. Unknown parameters raise TypeError, bad values
     ValueError, failures of the core ``DacpoError``. The GIL is released while
     the core runs.
     """
@@ -192,10 +196,31 @@ def orient(points, normals=None, *, progress=None, **params):
             checked["viewpoint"] = tuple((_np.asarray(checked["viewpoint"]) - centre) / scale)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable(stage_name, fraction) -> bool")
+    # rows with a NaN or inf coordinate get NaN normals and labels -1, as in
+    # the PCL class and the CLI; the rest is oriented without them
+    keep = _np.isfinite(a).all(axis=1)
+    dropped = not keep.all()
+    if dropped:
+        a = a[keep]
+        given = given[keep] if given is not None else None
     raw = _core.orient(a, given, checked, progress)
     if raw["status"] != 0:
         raise DacpoError(raw["status"], raw["status_name"], raw["message"])
+    if dropped:
+        raw = _restore_rows(raw, keep)
     return raw["normals"], OrientResult(raw)
+
+
+def _restore_rows(raw, keep):
+    """The per-point outputs of a run on points[keep], back on every row."""
+    out = dict(raw)
+    for key, fill in (("normals", _np.nan), ("confidence", _np.nan),
+                      ("component_labels", -1), ("block_labels", -1)):
+        v = _np.asarray(raw[key])
+        full = _np.full((len(keep),) + v.shape[1:], fill, dtype=v.dtype)
+        full[keep] = v
+        out[key] = full
+    return out
 
 
 def orient_o3d(pcd, **params):

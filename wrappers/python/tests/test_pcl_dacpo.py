@@ -124,11 +124,28 @@ def test_bad_inputs_raise_clear_errors():
     with pytest.raises(pcl_dacpo.DacpoError) as e:
         pcl_dacpo.orient(np.zeros((0, 3)))
     assert e.value.status == 2 and "empty" in e.value.status_name
-    pts, _ = pcl_dacpo.make_scene("plane", 300)
+    # NaN rows as in the PCL class and the CLI: NaN normals and labels -1 there,
+    # the rest oriented as without them
+    pts, gt = pcl_dacpo.make_scene("box", 3000, seed=3)
+    ref, _ = pcl_dacpo.orient(np.delete(pts, [7, 100], axis=0), ipsr_enabled=False, seed=2)
     pts[7, 1] = np.nan
-    with pytest.raises(pcl_dacpo.DacpoError) as e:
-        pcl_dacpo.orient(pts, np.tile([0, 0, 1], (300, 1)))
-    assert "7" in e.value.message  # names the first bad point
+    pts[100, 0] = np.inf
+    got, res = pcl_dacpo.orient(pts, ipsr_enabled=False, seed=2)
+    assert got.shape == (3000, 3)
+    assert np.isnan(got[[7, 100]]).all() and np.isfinite(np.delete(got, [7, 100], axis=0)).all()
+    np.testing.assert_array_equal(np.delete(got, [7, 100], axis=0), ref)
+    assert res.block_labels[7] == -1 and res.component_labels[100] == -1
+    assert np.isnan(res.confidence[7]) and len(res.confidence) == 3000
+
+
+def test_an_open3d_cloud_names_orient_o3d():
+    class FakeO3dCloud:  # what orient() sees of an open3d.geometry.PointCloud
+        points = np.zeros((10, 3))
+
+        def has_normals(self):
+            return False
+    with pytest.raises(TypeError, match="orient_o3d"):
+        pcl_dacpo.orient(FakeO3dCloud())
 
 
 def test_dtype_and_memory_order_do_not_change_the_answer():
