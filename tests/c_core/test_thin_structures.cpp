@@ -211,31 +211,48 @@ worstOfSeeds(const SceneCase& c)
 // alone, whose inside-out state has the same Eq. 1 energy, and the seams to
 // the legs carry little evidence. With the library's side cue (0.001) the
 // same table was inside out on all three seeds with blocks of 1,250 (24.54 /
-// 24.37 / 24.55 %) and is now on one (3.85 / 27.23 / 2.92 %). The bound
-// records today's state (top and legs turned over as a whole, ~24 %), not a
-// goal: above it, more than the table went wrong.
-TEST(DacpoThinStructures, ThinObjects)
+// 24.37 / 24.55 %) and is now on one (3.85 / 27.23 / 2.92 %): a known failure,
+// kept apart below (DISABLED_TableTopStaysWithItsLegs) with the goal as its
+// bound, not today's value.
+namespace {
+void
+checkThinObjects(const std::vector<SceneCase>& cases)
 {
-  const std::vector<SceneCase> cases = {
-      {DACPO_SCENE_BOARD, 5600, 0.0, 6.5},
-      {DACPO_SCENE_TUBE, 6300, 0.0, 2.0},
-      {DACPO_SCENE_TABLE, 31000, 0.0, 25.0},
-      {DACPO_SCENE_PARTITION, 55000, 0.0, 14.0},
-      {DACPO_SCENE_PARTITION, 55000, 0.0, 1.0, 0.5},
-  };
   for (const SceneCase& c : cases) {
     double worst = 0.0;
     for (uint64_t seed = 1; seed <= 3; ++seed)
       worst = std::max(worst, orientScene(c, seed));
-    RecordProperty(std::string("worst_percent_") + dacpo_scene_kind_name(c.kind) +
-                       (c.sides > 0.0 ? "_sides" : ""),
-                   std::to_string(worst));
+    ::testing::Test::RecordProperty(std::string("worst_percent_") +
+                                        dacpo_scene_kind_name(c.kind) +
+                                        (c.sides > 0.0 ? "_sides" : ""),
+                                    std::to_string(worst));
     printf("%-10s sides %.1f worst of seeds 1-3: %.2f %% wrong\n",
            dacpo_scene_kind_name(c.kind),
            c.sides,
            worst);
     EXPECT_LE(worst, c.bound) << dacpo_scene_kind_name(c.kind);
   }
+}
+} // namespace
+
+TEST(DacpoThinStructures, ThinObjects)
+{
+  checkThinObjects({
+      {DACPO_SCENE_BOARD, 5600, 0.0, 6.5},
+      {DACPO_SCENE_TUBE, 6300, 0.0, 2.0},
+      {DACPO_SCENE_PARTITION, 55000, 0.0, 14.0},
+      {DACPO_SCENE_PARTITION, 55000, 0.0, 1.0, 0.5},
+  });
+}
+
+// Known failure: on one seed of three the table's top and legs come out turned
+// over as a whole relative to the floor (24.19 % worst of seeds 1-3 on
+// 2026-12-04: its top's blocks have the
+// same Eq. 1 energy inside out, and the seams to the legs carry little
+// evidence). The bound is the goal; enable when it holds.
+TEST(DacpoThinStructures, DISABLED_TableTopStaysWithItsLegs)
+{
+  checkThinObjects({{DACPO_SCENE_TABLE, 31000, 0.0, 5.0}});
 }
 
 // The 2 cm partition between two walls with noise sigma = 5 mm (0.2 of its
@@ -321,7 +338,8 @@ TEST(DacpoThinStructures, RoomThinObjectsFollowTheirCueAfterStage6)
     char err[256];
     ASSERT_EQ(dacpo_scene_generate(&sp, &sc, err, sizeof(err)), 0) << err;
     const double wrong = orientAndScore(sc, 0.0, c.run_seed, 0.001);
-    printf("room (scene seed %llu, %zu points, sigma %.3f), run seed %llu: %.2f %% wrong\n",
+    printf("room (scene seed %llu, %zu points, sigma %.3f), run seed %llu: %.2f %% "
+           "wrong\n",
            static_cast<unsigned long long>(c.scene_seed),
            c.points,
            c.noise,
