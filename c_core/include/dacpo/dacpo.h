@@ -442,7 +442,8 @@ typedef struct dacpo_stats {
                                    the share of its surface points with a second
                                    parallel sheet within two spacings (>= 0.04:
                                    copies all over it, the two-sheet rule is left
-                                   out too); 0 when the test did not run */
+                                   out too and c is 1); 0 when the test did not
+                                   run */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -187,7 +187,8 @@ typedef struct two_sheet_scale {
 #define DACPO_TWO_SHEET_MAX_GAP 2.0     /* x local spacing */
 #define DACPO_TWO_SHEET_WEIGHT 3.0
 /* A block is seen from one side when under this share of its points has a
- * second sheet beneath it. Measured per block (~2,500 points): single depth
+ * second sheet beneath it. Measured per block (on blocks of ~2,500 points;
+ * today's default is ~625): single depth
  * frames 0-2.6 %, room blocks holding thin furniture mostly 3-53 %; blocks of
  * sparse rooms (10K points), whose thin parts lie closer than the two-sheet
  * test resolves, also stay below: there the rule keeps to offsets beyond the
