@@ -207,6 +207,14 @@ rank_of_index(const tiles_run* t, uint64_t idx)
   return lo;
 }
 
+static int
+plan_from_samples(tiles_run* t,
+                  const float* sample,
+                  size_t got,
+                  uint64_t max_points,
+                  double halo,
+                  dacpo_mpi_tiles_report* rep);
+
 /* read: check this rank's range, contribute to the sample, build the plan. */
 static int
 read_and_plan(tiles_run* t,
@@ -264,7 +272,22 @@ read_and_plan(tiles_run* t,
     free(sample);
     return 0;
   }
-  /* gather the sample everywhere, in rank (= input) order */
+  ok = plan_from_samples(t, sample, got, max_points, halo, rep);
+  free(sample);
+  return ok;
+}
+
+/* The samples of every rank, gathered everywhere in rank (= input) order, give
+ * the same plan on every rank; its tiles are dealt to the ranks by size. */
+static int
+plan_from_samples(tiles_run* t,
+                  const float* sample,
+                  size_t got,
+                  uint64_t max_points,
+                  double halo,
+                  dacpo_mpi_tiles_report* rep)
+{
+  int ok = 1;
   int* cnt = malloc(2 * (size_t)t->ranks * sizeof(int));
   const int my = (int)(3 * got);
   MPI_Allgather(&my, 1, MPI_INT, cnt, 1, MPI_INT, MPI_COMM_WORLD);
@@ -276,7 +299,6 @@ read_and_plan(tiles_run* t,
   }
   float* all = malloc((m3 ? m3 : 1) * sizeof(float));
   MPI_Allgatherv(sample, my, MPI_FLOAT, all, cnt, disp, MPI_FLOAT, MPI_COMM_WORLD);
-  free(sample);
   char msg[400];
   ok = dacpo_tile_plan_create(all, m3 / 3, t->n, max_points, halo, &t->plan, msg, sizeof(msg)) ==
        DACPO_OK;
@@ -361,23 +383,17 @@ route(tiles_run* t, dacpo_mpi_tiles_report* rep)
   return dacpo_mpi_all_ok(ok);
 }
 
-/* tiles + join: orient this rank's tiles; halo normals to the owners' ranks;
- * evidence summed on rank 0; flips everywhere. Own normals stay in the
- * tiles' records (xyz replaced by the normal: the position is not needed
- * again). */
+/* Orients this rank's tiles one at a time: own records keep their normal (in
+ * place of xyz), halo records leave as messages to the owner tile's rank. */
 static int
-orient_and_join(tiles_run* t,
-                const dacpo_params* params,
-                uint8_t* flip,
-                dacpo_mpi_tiles_report* rep)
+orient_own_tiles(tiles_run* t,
+                 const dacpo_params* p,
+                 vec* out,
+                 uint64_t* own_count,
+                 dacpo_mpi_tiles_report* rep)
 {
   dacpo_ctx* ctx = NULL;
   int ok = dacpo_ctx_create(&ctx) == DACPO_OK;
-  vec* out = calloc((size_t)t->ranks, sizeof(vec));
-  uint64_t* own_count = calloc(t->T, sizeof(uint64_t));
-  ok = ok && out && own_count;
-  const dacpo_params p = dacpo_tiled_params(params);
-  double t0 = now_s();
   for (size_t k = 0; ok && k < t->T; ++k) {
     if (t->tile_rank[k] != t->rank || t->tile[k].size == 0)
       continue;
@@ -389,7 +405,7 @@ orient_and_join(tiles_run* t,
     for (size_t i = 0; ok && i < cnt; ++i)
       memcpy(xyz + 3 * i, rec[i].xyz, sizeof(rec[i].xyz));
     const double b0 = now_s();
-    if (ok && dacpo_orient(ctx, &p, NULL, NULL, xyz, nrm, cnt) != DACPO_OK) {
+    if (ok && dacpo_orient(ctx, p, NULL, NULL, xyz, nrm, cnt) != DACPO_OK) {
       fprintf(stderr, "Error (rank %d): tile %zu (%zu points): %s\n", t->rank, k, cnt,
               dacpo_ctx_last_error(ctx));
       ok = 0;
@@ -424,16 +440,17 @@ orient_and_join(tiles_run* t,
     free(nrm);
   }
   dacpo_ctx_free(ctx);
-  rep->wall[2] = now_s() - t0;
-  t0 = now_s();
-  vec in = {NULL, 0, 0};
-  ok = dacpo_mpi_all_ok(ok) && exchange(out, t->ranks, &in, &rep->traffic);
-  const size_t T = t->T;
-  dacpo_tile_pairs ev = {NULL, 0, 0, NULL};
-  ok = dacpo_mpi_all_ok(ok && dacpo_tile_pairs_init(&ev, T));
-  for (size_t b = 0; ok && b < in.size; b += sizeof(halo_msg)) {
+  return ok;
+}
+
+/* The halo messages this rank received, against its own tiles' normals: the
+ * evidence of each tile pair (a, b), summed in the order tile a listed them. */
+static int
+halo_evidence(const tiles_run* t, const vec* in, dacpo_tile_pairs* ev)
+{
+  for (size_t b = 0; b < in->size; b += sizeof(halo_msg)) {
     halo_msg h;
-    memcpy(&h, in.data + b, sizeof(h));
+    memcpy(&h, in->data + b, sizeof(h));
     /* the owner's normal: binary search in its tile (own records, by index) */
     const routed* rec = (const routed*)t->tile[h.b].data;
     size_t lo = 0, hi = t->tile[h.b].size / sizeof(routed);
@@ -447,69 +464,104 @@ orient_and_join(tiles_run* t,
     if (lo >= t->tile[h.b].size / sizeof(routed) || rec[lo].idx != h.idx) {
       fprintf(stderr, "Error (rank %d): internal: point %llu not in tile %d\n", t->rank,
               (unsigned long long)h.idx, h.b);
-      ok = 0;
-      break;
+      return 0;
     }
     const float* o = rec[lo].xyz;
     const double d = (double)h.n[0] * o[0] + (double)h.n[1] * o[1] + (double)h.n[2] * o[2];
-    dacpo_tile_overlap* e = dacpo_tile_pairs_get(&ev, (uint32_t)h.a, (uint32_t)h.b);
+    dacpo_tile_overlap* e = dacpo_tile_pairs_get(ev, (uint32_t)h.a, (uint32_t)h.b);
     if (!e) {
       fprintf(stderr, "Error (rank %d): out of memory\n", t->rank);
-      ok = 0;
-      break;
+      return 0;
     }
-    /* in the order tile a listed them: the same sums as in one process */
     if (d >= 0.0)
       e->same += fabs(d);
     else
       e->opposite += fabs(d);
   }
+  return 1;
+}
+
+/* Each (a, b) comes from one rank (tile b's): rank 0 gathers the lists and
+ * the own points per tile (each counted on its tile's rank), joins, and
+ * sends every rank the flips. */
+static int
+join_on_rank0(tiles_run* t,
+              const dacpo_tile_pairs* ev,
+              const uint64_t* own_count,
+              uint8_t* flip,
+              dacpo_mpi_tiles_report* rep)
+{
+  const size_t T = t->T;
+  int ok = 1;
+  double* own = calloc(T ? T : 1, sizeof(double));
+  double* own_sum = t->rank == 0 ? calloc(T ? T : 1, sizeof(double)) : NULL;
+  for (size_t k = 0; own && k < T; ++k)
+    own[k] = (double)own_count[k];
+  MPI_Reduce(own, own_sum, (int)T, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+  const int bytes = (int)(ev->used * sizeof(dacpo_tile_overlap));
+  int* cnt = t->rank == 0 ? malloc(2 * (size_t)t->ranks * sizeof(int)) : NULL;
+  MPI_Gather(&bytes, 1, MPI_INT, cnt, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  size_t total = 0;
+  if (t->rank == 0)
+    for (int r = 0; r < t->ranks; ++r) {
+      cnt[t->ranks + r] = (int)total;
+      total += (size_t)cnt[r];
+    }
+  dacpo_tile_overlap* all = t->rank == 0 ? malloc(total ? total : 1) : NULL;
+  MPI_Gatherv(ev->entry, bytes, MPI_BYTE, all, cnt, cnt ? cnt + t->ranks : NULL, MPI_BYTE, 0,
+              MPI_COMM_WORLD);
+  if (t->rank == 0) {
+    uint64_t* pts = malloc((T ? T : 1) * sizeof(uint64_t));
+    ok = own_sum && all && pts;
+    for (size_t k = 0; ok && k < T; ++k)
+      pts[k] = (uint64_t)own_sum[k];
+    char msg[400];
+    if (ok && dacpo_tile_join(T, all, total / sizeof(dacpo_tile_overlap), pts, flip, msg,
+                              sizeof(msg)) != DACPO_OK) {
+      fprintf(stderr, "Error: %s\n", msg);
+      ok = 0;
+    }
+    for (size_t k = 0; ok && k < T; ++k)
+      rep->flipped_tiles += flip[k];
+    free(pts);
+  }
+  free(all);
+  free(cnt);
+  free(own);
+  free(own_sum);
+  MPI_Bcast(flip, (int)T, MPI_BYTE, 0, MPI_COMM_WORLD);
+  return ok;
+}
+
+/* tiles + join: orient this rank's tiles; halo normals to the owners' ranks;
+ * evidence summed on rank 0; flips everywhere. Own normals stay in the
+ * tiles' records (xyz replaced by the normal: the position is not needed
+ * again). */
+static int
+orient_and_join(tiles_run* t,
+                const dacpo_params* params,
+                uint8_t* flip,
+                dacpo_mpi_tiles_report* rep)
+{
+  vec* out = calloc((size_t)t->ranks, sizeof(vec));
+  uint64_t* own_count = calloc(t->T, sizeof(uint64_t));
+  const dacpo_params p = dacpo_tiled_params(params);
+  double t0 = now_s();
+  int ok = out && own_count && orient_own_tiles(t, &p, out, own_count, rep);
+  rep->wall[2] = now_s() - t0;
+  t0 = now_s();
+  vec in = {NULL, 0, 0};
+  ok = dacpo_mpi_all_ok(ok) && exchange(out, t->ranks, &in, &rep->traffic);
+  dacpo_tile_pairs ev = {NULL, 0, 0, NULL};
+  ok = dacpo_mpi_all_ok(ok && dacpo_tile_pairs_init(&ev, t->T));
+  ok = ok && halo_evidence(t, &in, &ev);
   free(in.data);
   for (int d = 0; out && d < t->ranks; ++d)
     free(out[d].data);
   free(out);
   ok = dacpo_mpi_all_ok(ok);
-  if (ok) {
-    /* each (a, b) comes from one rank (tile b's): rank 0 gathers the lists,
-     * and the own points per tile (each counted on its tile's rank) */
-    double* own = calloc(T ? T : 1, sizeof(double));
-    double* own_sum = t->rank == 0 ? calloc(T ? T : 1, sizeof(double)) : NULL;
-    for (size_t k = 0; own && k < T; ++k)
-      own[k] = (double)own_count[k];
-    MPI_Reduce(own, own_sum, (int)T, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-    const int bytes = (int)(ev.used * sizeof(dacpo_tile_overlap));
-    int* cnt = t->rank == 0 ? malloc(2 * (size_t)t->ranks * sizeof(int)) : NULL;
-    MPI_Gather(&bytes, 1, MPI_INT, cnt, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    size_t total = 0;
-    if (t->rank == 0)
-      for (int r = 0; r < t->ranks; ++r) {
-        cnt[t->ranks + r] = (int)total;
-        total += (size_t)cnt[r];
-      }
-    dacpo_tile_overlap* all = t->rank == 0 ? malloc(total ? total : 1) : NULL;
-    MPI_Gatherv(ev.entry, bytes, MPI_BYTE, all, cnt, cnt ? cnt + t->ranks : NULL, MPI_BYTE, 0,
-                MPI_COMM_WORLD);
-    if (t->rank == 0) {
-      uint64_t* pts = malloc((T ? T : 1) * sizeof(uint64_t));
-      ok = own_sum && all && pts;
-      for (size_t k = 0; ok && k < T; ++k)
-        pts[k] = (uint64_t)own_sum[k];
-      char msg[400];
-      if (ok && dacpo_tile_join(T, all, total / sizeof(dacpo_tile_overlap), pts, flip, msg,
-                                sizeof(msg)) != DACPO_OK) {
-        fprintf(stderr, "Error: %s\n", msg);
-        ok = 0;
-      }
-      for (size_t k = 0; ok && k < T; ++k)
-        rep->flipped_tiles += flip[k];
-      free(pts);
-    }
-    free(all);
-    free(cnt);
-    free(own);
-    free(own_sum);
-    MPI_Bcast(flip, (int)T, MPI_BYTE, 0, MPI_COMM_WORLD);
-  }
+  if (ok)
+    ok = join_on_rank0(t, &ev, own_count, flip, rep);
   dacpo_tile_pairs_free(&ev);
   free(own_count);
   rep->wall[3] = now_s() - t0;
@@ -532,6 +584,10 @@ write_all_at(MPI_File fh, MPI_Offset at, const void* buf, size_t bytes, char* er
   return 1;
 }
 
+static int
+write_file(tiles_run* t, const char* path);
+
+/* The normals back to the ranks that own their rows, then the file. */
 static int
 write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tiles_report* rep)
 {
@@ -567,9 +623,15 @@ write_output(tiles_run* t, const char* path, const uint8_t* flip, dacpo_mpi_tile
   for (int d = 0; out && d < t->ranks; ++d)
     free(out[d].data);
   free(out);
-  if (!ok)
-    return 0;
-  /* MPI-IO: a temporary file beside the output, renamed by rank 0 at the end */
+  return ok && write_file(t, path);
+}
+
+/* MPI-IO: every rank writes its range into a temporary file beside the
+ * output, renamed by rank 0 at the end. */
+static int
+write_file(tiles_run* t, const char* path)
+{
+  int ok = 1;
   char tmp[4200];
   long pid = (long)getpid();
   MPI_Bcast(&pid, 1, MPI_LONG, 0, MPI_COMM_WORLD);

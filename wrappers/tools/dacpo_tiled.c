@@ -633,6 +633,32 @@ finish_output(tiled_run* r, char* err, size_t errlen)
   return 0;
 }
 
+/* The prefix of the tile and halo files: beside the output unless told
+ * otherwise; the longest tile name and the output's temporary sibling must fit. */
+static int
+temp_prefix(tiled_run* r, char* err, size_t errlen)
+{
+  const dacpo_tiled_options* opt = r->opt;
+  char dir[3900];
+  if (opt->tmp_dir)
+    snprintf(dir, sizeof(dir), "%s", opt->tmp_dir);
+  else {
+    snprintf(dir, sizeof(dir), "%s", opt->output);
+    char* slash = strrchr(dir, '/');
+    if (slash)
+      *slash = '\0';
+    else
+      snprintf(dir, sizeof(dir), ".");
+  }
+  const int len =
+      snprintf(r->tmp_prefix, sizeof(r->tmp_prefix), "%s/.dacpo%ld", dir, (long)getpid());
+  char probe[4096];
+  if (len <= 0 || (size_t)len + 32 > sizeof(r->tmp_prefix) ||
+      dacpo_temp_sibling(opt->output, "tmp", (long)getpid(), probe, sizeof(probe)) != 0)
+    return fail(err, errlen, "'%s': name too long for temporary files beside it", opt->output);
+  return 0;
+}
+
 int
 dacpo_tiled_orient(const dacpo_tiled_options* opt,
                    dacpo_tiled_report* rep,
@@ -655,29 +681,9 @@ dacpo_tiled_orient(const dacpo_tiled_options* opt,
   r.chunk = malloc(3 * (size_t)TILED_CHUNK * sizeof(float) * 2);
   if (!r.chunk)
     return fail(err, errlen, "out of memory");
-  {
-    /* tile files beside the output unless told otherwise */
-    char dir[3900];
-    if (opt->tmp_dir)
-      snprintf(dir, sizeof(dir), "%s", opt->tmp_dir);
-    else {
-      snprintf(dir, sizeof(dir), "%s", opt->output);
-      char* slash = strrchr(dir, '/');
-      if (slash)
-        *slash = '\0';
-      else
-        snprintf(dir, sizeof(dir), ".");
-    }
-    const int len =
-        snprintf(r.tmp_prefix, sizeof(r.tmp_prefix), "%s/.dacpo%ld", dir, (long)getpid());
-    char probe[4096];
-    /* the longest tile name must fit, and the output's temporary sibling */
-    if (len <= 0 || (size_t)len + 32 > sizeof(r.tmp_prefix) ||
-        dacpo_temp_sibling(opt->output, "tmp", (long)getpid(), probe, sizeof(probe)) != 0) {
-      free(r.chunk);
-      return fail(err, errlen, "'%s': name too long for temporary files beside it",
-                  opt->output);
-    }
+  if (temp_prefix(&r, err, errlen) != 0) {
+    free(r.chunk);
+    return -1;
   }
   double t0 = now_s();
   int rc = dacpo_ply_rows_open(opt->input, &r.rows, err, errlen) != 0;

@@ -113,6 +113,32 @@ parse_size(const char* s, size_t* out)
   return 1;
 }
 
+/* A positive finite number for option name, or 0 with a message. */
+static int
+positive(const char* text, double* out, const char* name, char* msg, size_t msg_size)
+{
+  char* end = NULL;
+  *out = strtod(text, &end);
+  if (*end != '\0' || !(*out > 0.0) || !isfinite(*out)) {
+    snprintf(msg, msg_size, "%s needs a positive number, got %s", name, text);
+    return 0;
+  }
+  return 1;
+}
+
+/* Outputs are checked before the work: a known format, a writable folder. */
+static int
+check_outputs(const options* o, char* msg, size_t msg_size)
+{
+  const size_t ol = strlen(o->out);
+  if (!dacpo_is_pcd_path(o->out) && (ol < 4 || strcmp(o->out + ol - 4, ".ply") != 0)) {
+    snprintf(msg, msg_size, "the output must be a .ply or .pcd file, got %s", o->out);
+    return 0;
+  }
+  return dacpo_output_path_check(o->out, msg, msg_size) == 0 &&
+         (!o->report || dacpo_output_path_check(o->report, msg, msg_size) == 0);
+}
+
 static int
 parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
 {
@@ -132,12 +158,8 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
     else if (!strcmp(a, "-spread_knn"))
       o->spread_knn = 1;
     else if (!strcmp(a, "-knn_halo") && has_value) {
-      char* end = NULL;
-      o->knn_halo = strtod(argv[++i], &end);
-      if (*end != '\0' || !(o->knn_halo > 0.0) || !isfinite(o->knn_halo)) {
-        snprintf(msg, msg_size, "-knn_halo needs a positive number, got %s", argv[i]);
+      if (!positive(argv[++i], &o->knn_halo, "-knn_halo", msg, msg_size))
         return 0;
-      }
     }
     else if (!strcmp(a, "-memory") && has_value) {
       double x = 0.0;
@@ -148,12 +170,8 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
       o->tile_points = dacpo_tiled_points_for_memory(x);
     }
     else if (!strcmp(a, "-tile_halo") && has_value) {
-      char* end = NULL;
-      o->tile_halo = strtod(argv[++i], &end);
-      if (*end != '\0' || !(o->tile_halo > 0.0) || !isfinite(o->tile_halo)) {
-        snprintf(msg, msg_size, "-tile_halo needs a positive number, got %s", argv[i]);
+      if (!positive(argv[++i], &o->tile_halo, "-tile_halo", msg, msg_size))
         return 0;
-      }
     }
     else if (!strcmp(a, "-report") && has_value)
       o->report = argv[++i];
@@ -200,16 +218,7 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
     return 0;
-  /* outputs are checked before the work: a known format, a writable folder */
-  const size_t ol = strlen(o->out);
-  if (!dacpo_is_pcd_path(o->out) && (ol < 4 || strcmp(o->out + ol - 4, ".ply") != 0)) {
-    snprintf(msg, msg_size, "the output must be a .ply or .pcd file, got %s", o->out);
-    return 0;
-  }
-  if (dacpo_output_path_check(o->out, msg, msg_size) != 0 ||
-      (o->report && dacpo_output_path_check(o->report, msg, msg_size) != 0))
-    return 0;
-  return 1;
+  return check_outputs(o, msg, msg_size);
 }
 
 /* ---- dealing out units ------------------------------------------------- */

@@ -460,6 +460,80 @@ cmp_strength(const void* x, const void* y)
   return cmp_pair(x, y);
 }
 
+/* The overlaps as undirected pairs (a < b) into ed, (a, b) and (b, a) - the
+ * same pair seen from either owner - merged; returns their count. */
+static size_t
+merge_pairs(const dacpo_tile_overlap* ov, size_t num_ov, join_edge* ed)
+{
+  size_t ne = 0;
+  for (size_t e = 0; e < num_ov; ++e) {
+    if (ov[e].a == ov[e].b)
+      continue;
+    join_edge x = {ov[e].a < ov[e].b ? ov[e].a : ov[e].b,
+                   ov[e].a < ov[e].b ? ov[e].b : ov[e].a,
+                   ov[e].same,
+                   ov[e].opposite};
+    ed[ne++] = x;
+  }
+  qsort(ed, ne, sizeof(join_edge), cmp_pair);
+  size_t u = 0;
+  for (size_t e = 0; e < ne; ++e) {
+    if (u > 0 && ed[u - 1].a == ed[e].a && ed[u - 1].b == ed[e].b) {
+      ed[u - 1].same += ed[e].same;
+      ed[u - 1].opposite += ed[e].opposite;
+    }
+    else
+      ed[u++] = ed[e];
+  }
+  return u;
+}
+
+/* The spanning forest as adjacency lists: arcs of tile t from head[t] along
+ * next[], each to tile to[a] with relation rel[a] (+1 same sign, -1 opposite). */
+typedef struct tree_arcs {
+  const int32_t* head;
+  const int32_t* next;
+  const int32_t* to;
+  const int8_t* rel;
+} tree_arcs;
+
+/* Signs along each tree from its lowest tile; then the group keeps the sign
+ * most of its points' tiles chose themselves (flip in: 0; out: the flips). */
+static void
+sign_trees(size_t num_tiles,
+           const tree_arcs* g,
+           const uint64_t* tile_points,
+           int32_t* queue,
+           uint8_t* seen,
+           uint8_t* flip)
+{
+  for (size_t s = 0; s < num_tiles; ++s) {
+    if (seen[s])
+      continue;
+    size_t qh = 0, qt = 0;
+    queue[qt++] = (int32_t)s;
+    seen[s] = 1;
+    double kept = 0.0, flipped = 0.0;
+    while (qh < qt) {
+      const int32_t t = queue[qh++];
+      const double w = tile_points ? (double)tile_points[t] : 1.0;
+      if (flip[t])
+        flipped += w;
+      else
+        kept += w;
+      for (int32_t a = g->head[t]; a >= 0; a = g->next[a])
+        if (!seen[g->to[a]]) {
+          seen[g->to[a]] = 1;
+          flip[g->to[a]] = (uint8_t)(g->rel[a] > 0 ? flip[t] : !flip[t]);
+          queue[qt++] = g->to[a];
+        }
+    }
+    if (flipped > kept)
+      for (size_t q = 0; q < qt; ++q)
+        flip[queue[q]] = (uint8_t)!flip[queue[q]];
+  }
+}
+
 static dacpo_status
 tile_join(size_t num_tiles,
           const dacpo_tile_overlap* ov,
@@ -500,28 +574,7 @@ tile_join(size_t num_tiles,
     free(seen);
     return DACPO_OOM(err);
   }
-  /* merge (a, b) and (b, a): the same pair seen from either owner */
-  size_t ne = 0;
-  for (size_t e = 0; e < num_ov; ++e) {
-    if (ov[e].a == ov[e].b)
-      continue;
-    join_edge x = {ov[e].a < ov[e].b ? ov[e].a : ov[e].b,
-                   ov[e].a < ov[e].b ? ov[e].b : ov[e].a,
-                   ov[e].same,
-                   ov[e].opposite};
-    ed[ne++] = x;
-  }
-  qsort(ed, ne, sizeof(join_edge), cmp_pair);
-  size_t u = 0;
-  for (size_t e = 0; e < ne; ++e) {
-    if (u > 0 && ed[u - 1].a == ed[e].a && ed[u - 1].b == ed[e].b) {
-      ed[u - 1].same += ed[e].same;
-      ed[u - 1].opposite += ed[e].opposite;
-    }
-    else
-      ed[u++] = ed[e];
-  }
-  ne = u;
+  const size_t ne = merge_pairs(ov, num_ov, ed);
   qsort(ed, ne, sizeof(join_edge), cmp_strength);
   /* Kruskal: the maximum spanning forest of |same - opposite| */
   for (size_t t = 0; t < num_tiles; ++t) {
@@ -541,33 +594,8 @@ tile_join(size_t num_tiles,
     to[na] = (int32_t)ed[e].b, rel[na] = r, next[na] = head[ed[e].a], head[ed[e].a] = (int32_t)na, ++na;
     to[na] = (int32_t)ed[e].a, rel[na] = r, next[na] = head[ed[e].b], head[ed[e].b] = (int32_t)na, ++na;
   }
-  /* signs along each tree from its lowest tile; then the group keeps the sign
-   * most of its points' tiles chose themselves */
-  for (size_t s = 0; s < num_tiles; ++s) {
-    if (seen[s])
-      continue;
-    size_t qh = 0, qt = 0;
-    queue[qt++] = (int32_t)s;
-    seen[s] = 1;
-    double kept = 0.0, flipped = 0.0;
-    while (qh < qt) {
-      const int32_t t = queue[qh++];
-      const double w = tile_points ? (double)tile_points[t] : 1.0;
-      if (flip[t])
-        flipped += w;
-      else
-        kept += w;
-      for (int32_t a = head[t]; a >= 0; a = next[a])
-        if (!seen[to[a]]) {
-          seen[to[a]] = 1;
-          flip[to[a]] = (uint8_t)(rel[a] > 0 ? flip[t] : !flip[t]);
-          queue[qt++] = to[a];
-        }
-    }
-    if (flipped > kept)
-      for (size_t q = 0; q < qt; ++q)
-        flip[queue[q]] = (uint8_t)!flip[queue[q]];
-  }
+  const tree_arcs arcs = {head, next, to, rel};
+  sign_trees(num_tiles, &arcs, tile_points, queue, seen, flip);
   free(ed), free(parent), free(head), free(next), free(to), free(rel), free(queue);
   free(seen);
   return DACPO_OK;

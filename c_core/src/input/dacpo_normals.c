@@ -80,6 +80,55 @@ dacpo_jacobi3(double a[3][3], double w[3], double v[3][3])
     w[i] = a[i][i];
 }
 
+/* The axis of least variance of the covariance c (unit; +z for a degenerate
+ * one), the surface variation l0 / (l0 + l1 + l2) in *curv and, when elong is
+ * not NULL, l1 / l2 (middle over largest eigenvalue). */
+static void
+axis_of_covariance(double c[3][3], double nrm[3], double* curv, double* elong)
+{
+  /* Scale to max |c_ij| = 1 so tiny or huge neighbourhoods neither underflow
+   * nor overflow inside Jacobi; eigenvectors and l0/trace are scale-free. */
+  double mx = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int s = 0; s < 3; ++s)
+      if (fabs(c[r][s]) > mx)
+        mx = fabs(c[r][s]);
+  double w[3] = {0.0, 0.0, 0.0};
+  double v[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+  if (mx > 0.0 && isfinite(mx)) {
+    for (int r = 0; r < 3; ++r)
+      for (int s = 0; s < 3; ++s)
+        c[r][s] /= mx;
+    dacpo_jacobi3(c, w, v);
+  }
+  int lo = 0;
+  for (int d = 1; d < 3; ++d)
+    if (w[d] < w[lo])
+      lo = d;
+  double len = sqrt(v[0][lo] * v[0][lo] + v[1][lo] * v[1][lo] + v[2][lo] * v[2][lo]);
+  if (len > 0.0 && isfinite(len)) {
+    for (int d = 0; d < 3; ++d)
+      nrm[d] = v[d][lo] / len;
+  }
+  else {
+    nrm[0] = 0.0;
+    nrm[1] = 0.0;
+    nrm[2] = 1.0;
+  }
+  /* covariance is positive semi-definite; clamp rounding below zero */
+  double l[3], trace = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    l[d] = w[d] > 0.0 ? w[d] : 0.0;
+    trace += l[d];
+  }
+  *curv = trace > 0.0 ? l[lo] / trace : 0.0;
+  if (elong) {
+    const int hi = l[(lo + 1) % 3] >= l[(lo + 2) % 3] ? (lo + 1) % 3 : (lo + 2) % 3;
+    const int mid = 3 - lo - hi;
+    *elong = l[hi] > 0.0 ? l[mid] / l[hi] : 0.0;
+  }
+}
+
 /* PCA axis and surface variation of one neighbourhood; elong (may be NULL)
  * gets l1 / l2, the middle over the largest eigenvalue (near 0: the
  * neighbours lie along a line or a narrow strip). */
@@ -138,47 +187,7 @@ pca_point(const dacpo_cloud* cloud,
   c[2][0] = c[0][2];
   c[2][1] = c[1][2];
 
-  /* Scale to max |c_ij| = 1 so tiny or huge neighbourhoods neither underflow
-   * nor overflow inside Jacobi; eigenvectors and l0/trace are scale-free. */
-  double mx = 0.0;
-  for (int r = 0; r < 3; ++r)
-    for (int s = 0; s < 3; ++s)
-      if (fabs(c[r][s]) > mx)
-        mx = fabs(c[r][s]);
-  double w[3] = {0.0, 0.0, 0.0};
-  double v[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
-  if (mx > 0.0 && isfinite(mx)) {
-    for (int r = 0; r < 3; ++r)
-      for (int s = 0; s < 3; ++s)
-        c[r][s] /= mx;
-    dacpo_jacobi3(c, w, v);
-  }
-  int lo = 0;
-  for (int d = 1; d < 3; ++d)
-    if (w[d] < w[lo])
-      lo = d;
-  double len = sqrt(v[0][lo] * v[0][lo] + v[1][lo] * v[1][lo] + v[2][lo] * v[2][lo]);
-  if (len > 0.0 && isfinite(len)) {
-    for (int d = 0; d < 3; ++d)
-      nrm[d] = v[d][lo] / len;
-  }
-  else {
-    nrm[0] = 0.0;
-    nrm[1] = 0.0;
-    nrm[2] = 1.0;
-  }
-  /* covariance is positive semi-definite; clamp rounding below zero */
-  double l[3], trace = 0.0;
-  for (int d = 0; d < 3; ++d) {
-    l[d] = w[d] > 0.0 ? w[d] : 0.0;
-    trace += l[d];
-  }
-  *curv = trace > 0.0 ? l[lo] / trace : 0.0;
-  if (elong) {
-    const int hi = l[(lo + 1) % 3] >= l[(lo + 2) % 3] ? (lo + 1) % 3 : (lo + 2) % 3;
-    const int mid = 3 - lo - hi;
-    *elong = l[hi] > 0.0 ? l[mid] / l[hi] : 0.0;
-  }
+  axis_of_covariance(c, nrm, curv, elong);
 }
 
 /* Adaptive scale: per point the neighbourhood among 3/4, 1 and 3/2 x normal_k
