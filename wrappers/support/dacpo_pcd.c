@@ -69,6 +69,47 @@ tokens(char* line, char** tok, int max)
   return m;
 }
 
+/* A SIZE, TYPE or COUNT line: one value per field (val[0..nv)). */
+static int
+field_values(
+    pcd_header* h, const char* key, char** val, int nv, int lineno, char* err, size_t errlen)
+{
+  if (nv != h->nf) {
+    dacpo_support_err(err,
+                      errlen,
+                      "header line %d: %s has %d values for %d fields",
+                      lineno,
+                      key,
+                      nv,
+                      h->nf);
+    return 0;
+  }
+  for (int i = 0; i < h->nf; ++i) {
+    const char* v = val[i];
+    size_t x = 0;
+    if (key[0] == 'T') {
+      if (strlen(v) != 1 || !strchr("IUF", v[0])) {
+        dacpo_support_err(
+            err, errlen, "header line %d: TYPE '%s' is not I, U or F", lineno, v);
+        return 0;
+      }
+      h->f[i].type = v[0];
+    }
+    else if (!parse_count(v, &x) || x == 0 || x > (key[0] == 'S' ? 8u : 1000000u) ||
+             (key[0] == 'S' && x != 1 && x != 2 && x != 4 && x != 8)) {
+      dacpo_support_err(err, errlen, "header line %d: bad %s '%s'", lineno, key, v);
+      return 0;
+    }
+    else if (key[0] == 'S')
+      h->f[i].size = (int)x;
+    else
+      h->f[i].count = x;
+  }
+  h->have_size |= key[0] == 'S';
+  h->have_type |= key[0] == 'T';
+  return 1;
+}
+
 /* One header line (already without its newline) into h. */
 static int
 header_line(pcd_header* h, char* line, int lineno, char* err, size_t errlen)
@@ -93,42 +134,8 @@ header_line(pcd_header* h, char* line, int lineno, char* err, size_t errlen)
     }
     return 1;
   }
-  if (!strcmp(key, "SIZE") || !strcmp(key, "TYPE") || !strcmp(key, "COUNT")) {
-    if (m - 1 != h->nf) {
-      dacpo_support_err(err,
-                        errlen,
-                        "header line %d: %s has %d values for %d fields",
-                        lineno,
-                        key,
-                        m - 1,
-                        h->nf);
-      return 0;
-    }
-    for (int i = 0; i < h->nf; ++i) {
-      const char* v = tok[i + 1];
-      size_t x = 0;
-      if (key[0] == 'T') {
-        if (strlen(v) != 1 || !strchr("IUF", v[0])) {
-          dacpo_support_err(
-              err, errlen, "header line %d: TYPE '%s' is not I, U or F", lineno, v);
-          return 0;
-        }
-        h->f[i].type = v[0];
-      }
-      else if (!parse_count(v, &x) || x == 0 || x > (key[0] == 'S' ? 8u : 1000000u) ||
-               (key[0] == 'S' && x != 1 && x != 2 && x != 4 && x != 8)) {
-        dacpo_support_err(err, errlen, "header line %d: bad %s '%s'", lineno, key, v);
-        return 0;
-      }
-      else if (key[0] == 'S')
-        h->f[i].size = (int)x;
-      else
-        h->f[i].count = x;
-    }
-    h->have_size |= key[0] == 'S';
-    h->have_type |= key[0] == 'T';
-    return 1;
-  }
+  if (!strcmp(key, "SIZE") || !strcmp(key, "TYPE") || !strcmp(key, "COUNT"))
+    return field_values(h, key, tok + 1, m - 1, lineno, err, errlen);
   size_t* target = !strcmp(key, "WIDTH")    ? &h->width
                    : !strcmp(key, "HEIGHT") ? &h->height
                    : !strcmp(key, "POINTS") ? &h->points

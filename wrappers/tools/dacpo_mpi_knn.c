@@ -232,6 +232,23 @@ take_rows(dacpo_knn_table* t, uint8_t* want, const void* ans, size_t size, size_
   return 1;
 }
 
+/* A rank other than 0 for one round: its region's rows back to rank 0. A
+ * failed rank still answers (empty), so rank 0 is not left waiting. */
+static int
+answer_rank0(double* busy, dacpo_mpi_traffic* traffic, char* msg, size_t msg_size)
+{
+  size_t size = 0, asize = 0;
+  void* region = dacpo_mpi_recv(0, TAG_REGION, &size, NULL, traffic);
+  const double t0 = MPI_Wtime();
+  void* ans = region ? answer_region(region, size, &asize, msg, msg_size) : NULL;
+  *busy += MPI_Wtime() - t0;
+  dacpo_mpi_send(ans ? ans : "", ans ? asize : 0, 0, TAG_ROWS, traffic);
+  const int ok = ans != NULL;
+  free(region);
+  free(ans);
+  return ok;
+}
+
 int
 dacpo_mpi_knn(const float* xyz,
               size_t n,
@@ -292,18 +309,8 @@ dacpo_mpi_knn(const float* xyz,
       more = ok && open > 0;
       h *= KNN_HALO_GROWTH;
     }
-    else {
-      void* region = dacpo_mpi_recv(0, TAG_REGION, &size, NULL, traffic);
-      const double t0 = MPI_Wtime();
-      size_t asize = 0;
-      void* ans = region ? answer_region(region, size, &asize, msg, sizeof(msg)) : NULL;
-      *busy += MPI_Wtime() - t0;
-      /* a failed rank still answers (empty), so rank 0 is not left waiting */
-      dacpo_mpi_send(ans ? ans : "", ans ? asize : 0, 0, TAG_ROWS, traffic);
-      ok = ans != NULL;
-      free(region);
-      free(ans);
-    }
+    else
+      ok = answer_rank0(busy, traffic, msg, sizeof(msg));
     MPI_Request req;
     MPI_Ibcast(&more, 1, MPI_INT, 0, MPI_COMM_WORLD, &req);
     dacpo_mpi_wait(&req);

@@ -381,6 +381,36 @@ slab_parts_outward(const double* xyz,
   }
 }
 
+/* Per part its centroid, point count and bounding box; the whole cloud's box. */
+static void
+part_boxes(const double* xyz,
+           size_t n,
+           const int32_t* part,
+           size_t num_parts,
+           double* centre,
+           double* count,
+           double* lo,
+           double* hi,
+           double all_lo[3],
+           double all_hi[3])
+{
+  for (size_t i = 0; i < n; ++i) {
+    const size_t q = (size_t)part[i];
+    for (int d = 0; d < 3; ++d) {
+      const double x = xyz[3 * i + d];
+      centre[3 * q + d] += x;
+      lo[3 * q + d] = fmin(lo[3 * q + d], x);
+      hi[3 * q + d] = fmax(hi[3 * q + d], x);
+      all_lo[d] = fmin(all_lo[d], x);
+      all_hi[d] = fmax(all_hi[d], x);
+    }
+    count[q] += 1.0;
+  }
+  for (size_t q = 0; q < num_parts; ++q)
+    for (int d = 0; count[q] > 0.0 && d < 3; ++d)
+      centre[3 * q + d] /= count[q];
+}
+
 dacpo_status
 dacpo_part_closed_outward(const double* xyz,
                           const double* nrm,
@@ -414,21 +444,7 @@ dacpo_part_closed_outward(const double* xyz,
     lo[q] = HUGE_VAL;
     hi[q] = -HUGE_VAL;
   }
-  for (size_t i = 0; i < n; ++i) {
-    const size_t q = (size_t)part[i];
-    for (int d = 0; d < 3; ++d) {
-      const double x = xyz[3 * i + d];
-      centre[3 * q + d] += x;
-      lo[3 * q + d] = fmin(lo[3 * q + d], x);
-      hi[3 * q + d] = fmax(hi[3 * q + d], x);
-      all_lo[d] = fmin(all_lo[d], x);
-      all_hi[d] = fmax(all_hi[d], x);
-    }
-    count[q] += 1.0;
-  }
-  for (size_t q = 0; q < num_parts; ++q)
-    for (int d = 0; count[q] > 0.0 && d < 3; ++d)
-      centre[3 * q + d] /= count[q];
+  part_boxes(xyz, n, part, num_parts, centre, count, lo, hi, all_lo, all_hi);
   for (size_t i = 0; i < n; ++i) {
     const size_t q = (size_t)part[i];
     const double* c = centre + 3 * q;

@@ -42,6 +42,44 @@ smooth_pair(const double* xyz, const double* axes, size_t i, size_t j, double co
   return (oa > ob ? oa : ob) < sin_a * len;
 }
 
+/* Breadth-first from seed over smooth pairs into queue (returns its length);
+ * rel[j] = +1 where point j's current normal agrees with the one carried from
+ * the seed along the tree, -1 where not; *vote = sum of rel. */
+static size_t
+grow_patch(const double* xyz,
+           const double* axes,
+           const dacpo_adjacency* adj,
+           const int8_t* sign,
+           size_t seed,
+           double cos_a,
+           double sin_a,
+           int32_t* queue,
+           int8_t* rel,
+           long long* vote)
+{
+  size_t head = 0, tail = 0;
+  queue[tail++] = (int32_t)seed;
+  rel[seed] = 1;
+  *vote = 1;
+  while (head < tail) {
+    const size_t i = (size_t)queue[head++];
+    for (size_t k = adj->start[i]; k < adj->start[i + 1]; ++k) {
+      const size_t j = (size_t)adj->nbr[k];
+      if (rel[j] || !smooth_pair(xyz, axes, i, j, cos_a, sin_a))
+        continue;
+      const double* a = axes + 3 * i;
+      const double* b = axes + 3 * j;
+      const double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+      /* carried normal at j: sign_i rel_i a_i -> sign(d) (sign_i rel_i) b_j */
+      const int carried = (d > 0.0 ? 1 : -1) * sign[i] * rel[i];
+      rel[j] = (int8_t)(carried == sign[j] ? 1 : -1);
+      *vote += rel[j];
+      queue[tail++] = (int32_t)j;
+    }
+  }
+  return tail;
+}
+
 dacpo_status
 dacpo_surface_vote(const double* xyz,
                    const double* axes,
@@ -82,28 +120,8 @@ dacpo_surface_vote(const double* xyz,
   for (size_t seed = 0; seed < n; ++seed) {
     if (rel[seed])
       continue;
-    /* Breadth-first over smooth pairs; rel[j] = +1 where point j's current
-     * normal agrees with the one carried from the seed along the tree. */
-    size_t head = 0, tail = 0;
-    queue[tail++] = (int32_t)seed;
-    rel[seed] = 1;
-    long long vote = 1;
-    while (head < tail) {
-      const size_t i = (size_t)queue[head++];
-      for (size_t k = adj->start[i]; k < adj->start[i + 1]; ++k) {
-        const size_t j = (size_t)adj->nbr[k];
-        if (rel[j] || !smooth_pair(xyz, axes, i, j, cos_a, sin_a))
-          continue;
-        const double* a = axes + 3 * i;
-        const double* b = axes + 3 * j;
-        const double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        /* carried normal at j: sign_i rel_i a_i -> sign(d) (sign_i rel_i) b_j */
-        const int carried = (d > 0.0 ? 1 : -1) * sign[i] * rel[i];
-        rel[j] = (int8_t)(carried == sign[j] ? 1 : -1);
-        vote += rel[j];
-        queue[tail++] = (int32_t)j;
-      }
-    }
+    long long vote = 0;
+    const size_t tail = grow_patch(xyz, axes, adj, sign, seed, cos_a, sin_a, queue, rel, &vote);
     if (tail < min_points)
       continue;
     count_patches++;
