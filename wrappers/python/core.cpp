@@ -5,6 +5,7 @@
 // releases the GIL while the core runs and turns Ctrl-C or a progress callback
 // returning False into a clean cancel.
 #include <dacpo/dacpo.h>
+#include <dacpo/dacpo_param_table.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -25,47 +26,66 @@ namespace {
 
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
-/* Every dacpo_params field by name: (name, C default) for Python's checks. */
+/* The table's rows Python sees as keywords: all but the two the package sets
+ * itself (estimate_normals: from the normals argument; keep_mesh: no mesh
+ * out of Python). */
+bool
+pythonKeyword(const char* name)
+{
+  return std::strcmp(name, "estimate_normals") != 0 &&
+         std::strcmp(name, "keep_mesh") != 0;
+}
+
+/* A field as Python sees it, by the table's kind. */
+py::object
+toPySIZE(size_t v)
+{
+  return py::int_(v);
+}
+py::object
+toPyREAL(double v)
+{
+  return py::float_(v);
+}
+py::object
+toPyFLAG(int v)
+{
+  return py::bool_(v != 0);
+}
+py::object
+toPyINT(int v)
+{
+  return py::int_(v);
+}
+template <typename E>
+py::object
+toPyENUM(E v)
+{
+  return py::int_(static_cast<int>(v));
+}
+py::object
+toPyU64(uint64_t v)
+{
+  return py::int_(v);
+}
+py::object
+toPyUINT(unsigned v)
+{
+  return py::int_(v);
+}
+
+/* Every keyword with its C default (dacpo_param_table.h), for Python's checks. */
 py::dict
 defaultParams()
 {
   dacpo_params p;
   dacpo_params_init(&p);
   py::dict d;
-  d["k"] = p.k;
-  d["normal_k"] = p.normal_k;
-  d["num_blocks"] = p.num_blocks;
-  d["ring_hops"] = p.ring_hops;
-  d["dipole_c"] = p.dipole_c;
-  d["dipole_orders"] = p.dipole_orders;
-  d["dipole_neighbors"] = p.dipole_neighbors;
-  d["dipole_final_sweep"] = p.dipole_final_sweep;
-  d["ipsr_enabled"] = p.ipsr_enabled != 0;
-  d["ipsr_max_iterations"] = p.ipsr_max_iterations;
-  d["edge_weight"] = static_cast<int>(p.edge_weight);
-  d["solver_time_limit"] = p.solver_time_limit;
-  d["seed"] = p.seed;
-  d["num_threads"] = p.num_threads;
-  d["disconnected"] = static_cast<int>(p.disconnected);
-  d["dipole_noise_band"] = p.dipole_noise_band;
-  d["dipole_two_sheet"] = p.dipole_two_sheet;
-  d["dipole_layers"] = p.dipole_layers;
-  d["dipole_sides"] = p.dipole_sides;
-  d["cue_anchor"] = p.cue_anchor;
-  d["seam_dipole"] = p.seam_dipole;
-  d["surface_vote"] = p.surface_vote;
-  d["dipole_c_thin"] = p.dipole_c_thin;
-  d["normal_weight"] = p.normal_weight;
-  d["adaptive_normals"] = p.adaptive_normals != 0;
-  d["vcr_image_size"] = p.vcr_image_size;
-  d["vcr_views"] = p.vcr_views;
-  d["vcr_perspective"] = p.vcr_perspective != 0;
-  d["vcr_boundary_factor"] = p.vcr_boundary_factor != 0;
-  d["dipole_restarts"] = p.dipole_restarts;
-  d["dipole_restart_vote"] = p.dipole_restart_vote;
-  d["weak_edge_fraction"] = p.weak_edge_fraction;
-  d["sign_policy"] = static_cast<int>(p.sign_policy);
-  d["scan_kind"] = static_cast<int>(p.scan_kind);
+#define DACPO_PARAM(kind, name, def, who)                                              \
+  if (pythonKeyword(#name))                                                            \
+    d[#name] = toPy##kind(p.name);
+  DACPO_PARAMS()
+#undef DACPO_PARAM
   d["viewpoint"] = py::make_tuple(p.viewpoint[0], p.viewpoint[1], p.viewpoint[2]);
   return d;
 }
@@ -80,11 +100,50 @@ get(const py::dict& d, const char* name, T fallback)
     return fallback;
   try {
     return d[name].cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::value_error(
+        std::string(name) + "=" + py::repr(d[name]).cast<std::string>() +
+        ": not a value this keyword can take (see help(pcl_dacpo.orient))");
   }
-  catch (const py::cast_error&) {
-    throw py::value_error(std::string(name) + "=" + py::repr(d[name]).cast<std::string>() +
-                          ": not a value this keyword can take (see help(pcl_dacpo.orient))");
-  }
+}
+
+/* A keyword's value into a field, by the table's kind (the field keeps its
+ * value when the keyword is absent). */
+void
+fromPySIZE(const py::dict& d, const char* n, size_t& f)
+{
+  f = get<size_t>(d, n, f);
+}
+void
+fromPyREAL(const py::dict& d, const char* n, double& f)
+{
+  f = get<double>(d, n, f);
+}
+void
+fromPyFLAG(const py::dict& d, const char* n, int& f)
+{
+  f = get<bool>(d, n, f != 0) ? 1 : 0;
+}
+void
+fromPyINT(const py::dict& d, const char* n, int& f)
+{
+  f = get<int>(d, n, f);
+}
+template <typename E>
+void
+fromPyENUM(const py::dict& d, const char* n, E& f)
+{
+  f = static_cast<E>(get<int>(d, n, static_cast<int>(f)));
+}
+void
+fromPyU64(const py::dict& d, const char* n, uint64_t& f)
+{
+  f = get<uint64_t>(d, n, f);
+}
+void
+fromPyUINT(const py::dict& d, const char* n, unsigned& f)
+{
+  f = get<unsigned>(d, n, f);
 }
 
 dacpo_params
@@ -92,45 +151,11 @@ toParams(const py::dict& d)
 {
   dacpo_params p;
   dacpo_params_init(&p);
-  p.k = get<size_t>(d, "k", p.k);
-  p.normal_k = get<size_t>(d, "normal_k", p.normal_k);
-  p.num_blocks = get<size_t>(d, "num_blocks", p.num_blocks);
-  p.ring_hops = get<size_t>(d, "ring_hops", p.ring_hops);
-  p.dipole_c = get<double>(d, "dipole_c", p.dipole_c);
-  p.dipole_orders = get<size_t>(d, "dipole_orders", p.dipole_orders);
-  p.dipole_neighbors = get<size_t>(d, "dipole_neighbors", p.dipole_neighbors);
-  p.dipole_final_sweep = get<int>(d, "dipole_final_sweep", p.dipole_final_sweep);
-  p.ipsr_enabled = get<bool>(d, "ipsr_enabled", p.ipsr_enabled != 0) ? 1 : 0;
-  p.ipsr_max_iterations = get<size_t>(d, "ipsr_max_iterations", p.ipsr_max_iterations);
-  p.edge_weight =
-      static_cast<dacpo_edge_weight>(get<int>(d, "edge_weight", p.edge_weight));
-  p.solver_time_limit = get<double>(d, "solver_time_limit", p.solver_time_limit);
-  p.seed = get<uint64_t>(d, "seed", p.seed);
-  p.num_threads = get<unsigned>(d, "num_threads", p.num_threads);
-  p.disconnected = static_cast<dacpo_disconnected_policy>(
-      get<int>(d, "disconnected", p.disconnected));
-  p.dipole_noise_band = get<double>(d, "dipole_noise_band", p.dipole_noise_band);
-  p.dipole_two_sheet = get<double>(d, "dipole_two_sheet", p.dipole_two_sheet);
-  p.dipole_layers = get<double>(d, "dipole_layers", p.dipole_layers);
-  p.dipole_sides = get<double>(d, "dipole_sides", p.dipole_sides);
-  p.cue_anchor = get<double>(d, "cue_anchor", p.cue_anchor);
-  p.seam_dipole = get<double>(d, "seam_dipole", p.seam_dipole);
-  p.surface_vote = get<size_t>(d, "surface_vote", p.surface_vote);
-  p.dipole_c_thin = get<double>(d, "dipole_c_thin", p.dipole_c_thin);
-  p.normal_weight = get<double>(d, "normal_weight", p.normal_weight);
-  p.adaptive_normals =
-      get<bool>(d, "adaptive_normals", p.adaptive_normals != 0) ? 1 : 0;
-  p.vcr_image_size = get<size_t>(d, "vcr_image_size", p.vcr_image_size);
-  p.vcr_views = get<size_t>(d, "vcr_views", p.vcr_views);
-  p.vcr_perspective = get<bool>(d, "vcr_perspective", p.vcr_perspective != 0) ? 1 : 0;
-  p.vcr_boundary_factor =
-      get<bool>(d, "vcr_boundary_factor", p.vcr_boundary_factor != 0) ? 1 : 0;
-  p.dipole_restarts = get<size_t>(d, "dipole_restarts", p.dipole_restarts);
-  p.dipole_restart_vote = get<int>(d, "dipole_restart_vote", p.dipole_restart_vote);
-  p.weak_edge_fraction = get<double>(d, "weak_edge_fraction", p.weak_edge_fraction);
-  p.sign_policy =
-      static_cast<dacpo_sign_policy>(get<int>(d, "sign_policy", p.sign_policy));
-  p.scan_kind = static_cast<dacpo_scan_kind>(get<int>(d, "scan_kind", p.scan_kind));
+#define DACPO_PARAM(kind, name, def, who)                                              \
+  if (pythonKeyword(#name))                                                            \
+    fromPy##kind(d, #name, p.name);
+  DACPO_PARAMS()
+#undef DACPO_PARAM
   if (d.contains("viewpoint")) {
     const py::tuple v = py::tuple(d["viewpoint"]);
     for (int i = 0; i < 3; ++i)
@@ -233,7 +258,8 @@ statsDict(const dacpo_stats* s)
   stats["sign_flipped"] = s->sign_flipped != 0;
   stats["sign_facing"] = s->sign_facing;
   stats["sign_enclosed"] = s->sign_enclosed != 0;
-  stats["scan_kind"] = s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
+  stats["scan_kind"] =
+      s->scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single_view" : "multi_view";
   stats["single_view_fit"] = s->single_view_fit;
   stats["layered_share"] = s->layered_share;
   stats["layered_copies"] = s->layered_copies;

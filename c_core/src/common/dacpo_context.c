@@ -4,6 +4,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "dacpo_context.h"
 
+#include <dacpo/dacpo_param_table.h>
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -69,43 +71,11 @@ dacpo_params_init(dacpo_params* p)
 {
   if (!p)
     return;
-  memset(p, 0, sizeof(*p));
-  p->k = 10;
-  p->normal_k = 16;
-  p->estimate_normals = 0;
-  p->num_blocks = 0;
-  p->ring_hops = 3;
-  p->dipole_c = -1.0;
-  p->dipole_orders = 5;
-  p->dipole_neighbors = 32;
-  p->dipole_final_sweep = 10;
-  p->ipsr_enabled = 1;
-  p->ipsr_max_iterations = 20;
-  p->edge_weight = DACPO_WEIGHT_VCR;
-  p->solver_time_limit = 30.0;
-  p->seed = 1;
-  p->num_threads = 0;
-  p->disconnected = DACPO_DISCONNECTED_VIEWPOINT;
-  p->dipole_noise_band = 0.0;
-  p->keep_mesh = 0;
-  p->vcr_image_size = 200;
-  p->vcr_views = 12;
-  p->vcr_perspective = 0;
-  p->vcr_boundary_factor = 1;
-  p->dipole_restarts = 16;
-  p->dipole_restart_vote = 1;
-  p->weak_edge_fraction = 1.0;
-  p->sign_policy = DACPO_SIGN_FREE_SPACE;
-  p->dipole_two_sheet = -1.0;
-  p->dipole_layers = -1.0;
-  p->dipole_sides = 0.001;
-  p->cue_anchor = 1.0;
-  p->seam_dipole = 0.5;
-  p->surface_vote = 500;
-  p->dipole_c_thin = 4.0;
-  p->normal_weight = 0.0;
-  p->adaptive_normals = 1;
-  p->scan_kind = DACPO_SCAN_AUTO;
+  memset(p, 0, sizeof(*p)); /* viewpoint (0, 0, 0) */
+  /* every default from the one table (dacpo_param_table.h) */
+#define DACPO_PARAM(kind, name, def, who) p->name = def;
+  DACPO_PARAMS()
+#undef DACPO_PARAM
 }
 
 static dacpo_status
