@@ -200,7 +200,8 @@ typedef struct dacpo_params {
   int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
   int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
   size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
-                                      each), 1..64 (16) */
+                                      each), 1..64 (16); voted runs stop after 4
+                                      that all agree */
   int dipole_restart_vote;       /**< 1: the restarts are voted point by point (each
                                       flipped as a whole to agree with the vote);
                                       0: the restart with the highest block energy

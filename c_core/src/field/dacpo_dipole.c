@@ -23,7 +23,8 @@
  * aligned by an exhaustive search over relative flips (minimum total Hamming
  * disagreement) and majority-voted; Gauss-Seidel sweeps then let every point
  * re-decide with all its K neighbours placed, until none changes. The whole
- * run is repeated `restarts` times with other orders; the runs are voted point
+ * run is repeated up to `restarts` times with other orders (voted runs stop
+ * after DACPO_DIPOLE_AGREE that all agree); the runs are voted point
  * by point (restart_vote, dipole_vote below), or the one with the highest
  * block energy sum_i s_i sum_t s_j e_ji is kept: one unlucky start no longer
  * decides a block.
@@ -50,6 +51,10 @@
 
 #define DACPO_DIPOLE_MAX_ORDERS 16
 #define DACPO_DIPOLE_MAX_RESTARTS 64
+/* Voted restarts that, all giving one answer (up to the block's sign), end the
+ * block's runs: more runs could only repeat it where they agree too
+ * (docs/DESIGN.md, "Speed"). */
+#define DACPO_DIPOLE_AGREE 4
 
 double
 dacpo_dipole_energy(const double p[3],
@@ -825,6 +830,20 @@ dipole_one_order(
 
 /* Relative flips of orders 1..M-1 against order 0 with the least total pairwise
  * disagreement (paper: exhaustive search over the alignments, M is small). */
+/* Restarts that all gave the same signs as the first, or all its opposite. */
+static int
+restarts_agree(const int8_t* cand, size_t n, size_t R)
+{
+  for (size_t r = 1; r < R; ++r) {
+    const int8_t* c = cand + r * n;
+    const int same = c[0] == cand[0];
+    for (size_t i = 1; i < n; ++i)
+      if ((c[i] == cand[i]) != same)
+        return 0;
+  }
+  return 1;
+}
+
 static unsigned
 dipole_align(const int8_t* sign, size_t n, size_t M)
 {
@@ -1112,7 +1131,7 @@ dacpo_dipole_orient_confidence(const double* xyz,
    * point (dipole_vote), or scored by the block's own energy sum_i sum_t s_i
    * s_j e_ij (Eq. 4 summed over all pairs) and the highest kept: either way
    * one unlucky start no longer decides the block. */
-  const size_t R = params->restarts ? params->restarts : 1;
+  size_t R = params->restarts ? params->restarts : 1;
   const int score = R > 1 && !params->restart_vote;
   double best_energy = -HUGE_VAL;
   size_t best = 0;
@@ -1123,6 +1142,10 @@ dacpo_dipole_orient_confidence(const double* xyz,
       best_energy = energy;
       best = r;
     }
+    /* the first DACPO_DIPOLE_AGREE runs gave one answer (up to the block's
+       sign): the vote of more could not change it where they agree too */
+    if (!score && r + 1 == DACPO_DIPOLE_AGREE && R > r + 1 && restarts_agree(wk.cand, n, r + 1))
+      R = r + 1;
   }
   if (R > 1 && params->restart_vote)
     dipole_vote(&wk, n, K, R, params->final_sweep, sign_out);
