@@ -162,13 +162,7 @@ typedef struct dacpo_params {
                              c resists depth noise; c = 1 leaves only the
                              tangential alignment n.(I - r r^T).m, no "stacked,
                              so opposite" vote - right where no part is seen from
-                             both sides. Measured here (full pipeline): c = 4 left
-                             22.9 % wrong on the largest components of our 15 real
-                             depth frames and 26 % on a room with noise 0.008;
-                             c = 1.5 kept a 2 cm board at 20K points (0.01 %
-                             wrong) that c = 1.2 got 9 % wrong; on the 15 frames
-                             (single views, seeds 1-5) c = 1 1.65 % against 1.82 %
-                             at 1.5. */
+                             both sides. */
   size_t dipole_orders; /**< M randomized BFS orders (5) */
   size_t dipole_neighbors;    /**< K nearest placed points summed per decision (32) */
   int dipole_final_sweep;     /**< re-decision sweeps after voting, repeated until no
@@ -185,16 +179,11 @@ typedef struct dacpo_params {
                                  below this many times the block's noise scale
                                  (median RMS offset of neighbours from the
                                  tangent plane) are treated as coplanar in
-                                 Eq. 1; 0 = off, the paper's field (0). With
-                                 c = 4 a band of 3 cut the error on a room
-                                 with noise 0.008 from 46 % to 10 %. */
+                                 Eq. 1; 0 = off, the paper's field (0) */
   int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
                                  wound to agree with them; see dacpo_ctx_mesh() (0) */
   size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (200; the
-                                 paper: 400 for its 200 blocks. With 400 blocks of
-                                 625 points, seeds 1-5, 400 -> 200 px: rooms 4.41
-                                 -> 4.39 %, frames 1.50 -> 1.51 %; 500K room
-                                 edge weights 12.8 -> 4.5 s) */
+                                 paper: 400 for its 200 blocks) */
   size_t vcr_views;         /**< VCR views: 12 = dodecahedron face centres (paper);
                                  other counts use a Fibonacci sphere, [1, 256] (12) */
   int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
@@ -210,9 +199,7 @@ typedef struct dacpo_params {
                                       alpha + alpha-bar is below this fraction of the
                                       median edge's do not join blocks into one part;
                                       0 = parts are the k-NN components (1: every
-                                      edge below the median; measured on 15 real
-                                      frames x 5 seeds: worst seed 8.55 % -> 5.75 %
-                                      against 0.1, rooms unchanged) */
+                                      edge below the median) */
   dacpo_sign_policy sign_policy; /**< global sign (DACPO_SIGN_FREE_SPACE) */
   double viewpoint[3];           /**< DACPO_SIGN_VIEWPOINT: the point normals face,
                                       in the input's frame (0, 0, 0) */
@@ -234,12 +221,9 @@ typedef struct dacpo_params {
                                       c = 1 - the stacked term no longer says
                                       "opposite" - in a block where under 3 % of the
                                       points have a second sheet beneath them
-                                      (dipole_two_sheet). Measured (0.5-2 spacings):
-                                      such pairs face the same way in 98-99.8 % of
-                                      cases on single depth frames, the opposite way in
-                                      72-97 % on rooms with thin parts. < 0 = by the
-                                      scan kind: 0.5 for a single view, 2 otherwise
-                                      (-1); 0 = off */
+                                      (dipole_two_sheet). < 0 = by the scan kind:
+                                      0.5 for a single view, 2 otherwise (-1);
+                                      0 = off */
   double dipole_sides;           /**< stage 2, parts thinner than the spacing (a
                                       board 0.3-1 spacing thick): where a point's
                                       parallel neighbours lie on two copies of one
@@ -252,12 +236,10 @@ typedef struct dacpo_params {
                                       >= 5 % of the points show it. Any value > 0
                                       turns the cue on; 0.001 (default) is pairs and
                                       stage 3 only (the field just breaks ties).
-                                      Seeds 1-5, 18 rooms / 15 depth frames, % wrong:
-                                      off 8.01 / 3.66, 0.001 7.40 / 3.66, 0.5 7.01 /
-                                      3.66 (larger seed spread, a generated 20K room
-                                      7.6-13.1 %). Left out where the scan
-                                      kind resolves to one depth view. 0 = off
-                                      (0.001) */
+                                      Left out where the scan kind resolves to one
+                                      depth view or the floor shows offset copies
+                                      (dacpo_stats::layered_share, layered_copies).
+                                      0 = off (0.001) */
   double cue_anchor;             /**< stage 5: the side cue (dipole_sides) is an
                                       absolute sign - the two faces of a thin part look
                                       away from each other - so a block where it fired
@@ -265,10 +247,7 @@ typedef struct dacpo_params {
                                       left it" (or "flipped", where the cue disagrees)
                                       with this weight times the share of its cue
                                       points that agree, scaled like an edge of Eq. 7
-                                      (n / (n + 100) for n cue points). Without it the
-                                      0-1 program trusted the seam evidence of a block
-                                      half wrong inside and turned a right bookcase
-                                      over. 0 = off (1) */
+                                      (n / (n + 100) for n cue points). 0 = off (1) */
   double dipole_c_thin;          /**< stage 2, blocks with thin two-sided parts
                                       (>= 3 % of the points have a second sheet
                                       beneath them, dipole_two_sheet > 0): a
@@ -277,20 +256,11 @@ typedef struct dacpo_params {
                                       local noise is geometry, not noise, and gets
                                       Eq. 1 with this c (the paper's clean-data
                                       value) instead of dipole_c. Blocks seen from
-                                      one side keep dipole_c. Seeds 1-5, 15 depth
-                                      frames / 18 rooms, % wrong: off 2.35 / 6.22,
-                                      4 2.36 / 5.95 (rooms with sigma 0.008: 7.23 ->
-                                      6.36); c = 4 everywhere (seed 1): frames
-                                      16.75. 0 = off (4) */
+                                      one side keep dipole_c. 0 = off (4) */
   double normal_weight;          /**< estimated normals: neighbours weigh
                                       exp(-d^2 / h^2) in the PCA, h = this x
                                       the distance of the middle one of the
-                                      normal_k; 0 = unweighted (0). Seeds 1-5,
-                                      15 frames / 18 rooms, % wrong (worst
-                                      seed; with adaptive_normals 0): 0 2.20
-                                      (2.42) / 5.82 (6.27); 1.5 2.02 (2.54) /
-                                      5.58 (6.07), largest seed spread 2.86
-                                      -> 3.12 / 1.66 -> 3.64 */
+                                      normal_k; 0 = unweighted (0) */
   int adaptive_normals;          /**< estimated normals: 1 = per point the
                                       neighbourhood among 3/4, 1 and 3/2 x
                                       normal_k that is flattest (lowest
@@ -298,26 +268,22 @@ typedef struct dacpo_params {
                                       normal_k only where its neighbours do
                                       not form a strip); the k-NN graph then
                                       keeps 3/2 x normal_k neighbours. 0 =
-                                      normal_k alone. Seeds 1-5, 15 frames /
-                                      18 rooms, % wrong (worst seed): 0 2.20
-                                      (2.42) / 5.82 (6.27); 1 2.03 (2.54) /
-                                      5.20 (5.63) (1) */
+                                      normal_k alone (1) */
   dacpo_scan_kind scan_kind;     /**< single depth view or many views (AUTO: decided
                                       from the sampling density, see
-                                      dacpo_stats::scan_kind). A single view keeps
-                                      the side cue (dipole_sides) to blocks where
-                                      >= 5 % of the points show a second face and
-                                      reads layers at 0.5 spacings; many views give
-                                      every block the cue, fitted over 32
-                                      neighbours instead of 24 (AUTO) */
+                                      dacpo_stats::scan_kind). A single view gets
+                                      c = 1, layers at 0.5 spacings, no two-sheet
+                                      rule and no side cue where those are left at
+                                      -1 / default; many views get c = 1.5, layers
+                                      at 2 spacings and the thin-part rules, unless
+                                      the floor shows offset copies (then c = 1 and
+                                      no two-sheet rule or side cue) (AUTO) */
   double seam_dipole;            /**< stage 4 with VCR weights: the dipole energy
                                       across each block seam (Eq. 2 over the k-NN
                                       pairs joining the two blocks) is added as a
                                       second measure, this x its evidence over its
-                                      typical edge's, VCR over its own. With
-                                      blocks of 625 points, seeds 1-5, 15 frames /
-                                      18 rooms: VCR alone 1.57 / 4.53 %, 0.5 1.50
-                                      / 4.41 % (README). 0 = VCR alone (0.5) */
+                                      typical edge's, VCR over its own. 0 = VCR
+                                      alone (0.5) */
   size_t surface_vote;           /**< after the 0-1 program: on every smooth surface
                                       of at least this many points (neighbours
                                       with axes within 8 degrees of parallel, each
