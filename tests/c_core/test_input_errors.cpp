@@ -577,7 +577,6 @@ TEST(DacpoInputErrors, InvalidParamsNameTheField)
        }},
       {"dipole_orders", [](dacpo_params* p) { p->dipole_orders = 0; }},
       {"dipole_neighbors", [](dacpo_params* p) { p->dipole_neighbors = 0; }},
-      {"dipole_noise_band", [](dacpo_params* p) { p->dipole_noise_band = -1.0; }},
       {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = INFINITY; }},
       {"dipole_two_sheet", [](dacpo_params* p) { p->dipole_two_sheet = std::nan(""); }},
       {"dipole_layers", [](dacpo_params* p) { p->dipole_layers = std::nan(""); }},

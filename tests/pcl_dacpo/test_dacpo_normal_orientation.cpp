@@ -503,7 +503,6 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   d.setSolverTimeLimit(2.5);
   d.setSeed(99);
   d.setNumberOfThreads(3);
-  d.setDipoleNoiseBand(2.5);
   d.setDisconnectedPolicy(Orientation::DisconnectedPolicy::Bridge);
   EXPECT_EQ(d.getCueAnchor(), 1.0); // the default
   d.setCueAnchor(0.25);
@@ -525,7 +524,6 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_EQ(d.getSolverTimeLimit(), 2.5);
   EXPECT_EQ(d.getSeed(), 99u);
   EXPECT_EQ(d.getNumberOfThreads(), 3u);
-  EXPECT_EQ(d.getDipoleNoiseBand(), 2.5);
   EXPECT_EQ(d.getDisconnectedPolicy(), Orientation::DisconnectedPolicy::Bridge);
   const dacpo_params p = d.getParameters();
   EXPECT_EQ(p.k, 10u);

@@ -312,11 +312,6 @@ const OptionSpec kOptions[] = {
        o.bridge = true;
        return true;
      }},
-    {"-band",
-     "X",
-     "dipole noise band, 0 = off",
-     showNumber<double, &dacpo_params::dipole_noise_band>,
-     setDouble<&dacpo_params::dipole_noise_band>},
     {"-two_sheet",
      "X",
      "thin parts: neighbours off each other's tangent plane by\n"

@@ -175,11 +175,6 @@ typedef struct dacpo_params {
   uint64_t seed;                 /**< all randomness derives from it (1) */
   unsigned num_threads;          /**< 0 = all cores (0) */
   dacpo_disconnected_policy disconnected; /**< (VIEWPOINT) */
-  double dipole_noise_band; /**< pairs whose offsets along both normals are
-                                 below this many times the block's noise scale
-                                 (median RMS offset of neighbours from the
-                                 tangent plane) are treated as coplanar in
-                                 Eq. 1; 0 = off, the paper's field (0) */
   int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
                                  wound to agree with them; see dacpo_ctx_mesh() (0) */
   size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (200; the

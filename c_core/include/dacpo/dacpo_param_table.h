@@ -37,7 +37,6 @@
   DACPO_PARAM(U64, seed, 1, USER)                                               \
   DACPO_PARAM(UINT, num_threads, 0, USER)                                       \
   DACPO_PARAM(ENUM, disconnected, DACPO_DISCONNECTED_VIEWPOINT, USER)           \
-  DACPO_PARAM(REAL, dipole_noise_band, 0.0, EXPERT)                             \
   DACPO_PARAM(FLAG, keep_mesh, 0, USER)                                         \
   DACPO_PARAM(SIZE, vcr_image_size, 200, EXPERT)                                \
   DACPO_PARAM(SIZE, vcr_views, 12, EXPERT)                                      \

@@ -192,15 +192,10 @@ check_iterations_solver(const dacpo_params* p, char* message, size_t size)
   return DACPO_OK;
 }
 
-/* Stage 2 field rules: noise band, two sheets, layers. */
+/* Stage 2 field rules: two sheets, layers. */
 static dacpo_status
 check_dipole_rules(const dacpo_params* p, char* message, size_t size)
 {
-  if (!(p->dipole_noise_band >= 0.0) || !isfinite(p->dipole_noise_band))
-    return bad_field(message,
-                     size,
-                     "dipole_noise_band must be finite and >= 0 (got %g)",
-                     p->dipole_noise_band);
   if (!isfinite(p->dipole_two_sheet))
     return bad_field(message,
                      size,

@@ -44,7 +44,6 @@ unit_dipole_params(const dacpo_params* p, size_t b, uint8_t* thin, int8_t* cue)
   dp.final_sweep = p->dipole_final_sweep;
   dp.seed = p->seed;
   dp.stream = (uint64_t)b;
-  dp.noise_band = p->dipole_noise_band;
   dp.two_sheet = p->dipole_two_sheet;
   dp.layers = p->dipole_layers;
   dp.c_thin = p->dipole_c_thin;

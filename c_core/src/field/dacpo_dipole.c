@@ -133,30 +133,6 @@ plane_offset(const double p[3], const double a[3], const double q[3])
   return (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
 }
 
-/* Median over points of the RMS distance of a point's K neighbours from its
- * tangent plane: the block's scale of "flat within noise". */
-static double
-block_noise_scale(const double* xyz,
-                  const double* nrm,
-                  size_t n,
-                  size_t K,
-                  const int32_t* nb,
-                  double* tmp)
-{
-  for (size_t i = 0; i < n; ++i) {
-    const double* p = xyz + 3 * i;
-    const double* m = nrm + 3 * i;
-    double s2 = 0.0;
-    for (size_t t = 0; t < K; ++t) {
-      const double* q = xyz + 3 * (size_t)nb[i * K + t];
-      const double d = plane_offset(p, m, q);
-      s2 += d * d;
-    }
-    tmp[i] = sqrt(s2 / (double)K);
-  }
-  return dacpo_select_kth(tmp, n, n / 2);
-}
-
 /* Two sheets of one thin part (a table top, a shelf board, a partition) lie a
  * gap of about one spacing apart with parallel axes. Eq. 1 gives such a pair a
  * stacked term -c (r^.n)(r^.m) that only wins for neighbours nearly straight
@@ -403,15 +379,14 @@ beyond_noise(const two_sheet_scale* ts,
  * Eq. 1-2 with constant c, except for two sheets of one thin part (opposite),
  * layers of a one-sided surface (c = 1) and, in a block with thin two-sided
  * parts, pairs off each other's tangent plane beyond the two-sheet noise test
- * (c_thin); pairs within the noise band (band > 0) drop the c term. */
+ * (c_thin). */
 static double
 pair_energy(const two_sheet_scale* ts,
             const double* xyz,
             const double* nrm,
             size_t i,
             size_t j,
-            double c,
-            double band)
+            double c)
 {
   const double* p = xyz + 3 * j;
   const double* q = xyz + 3 * i;
@@ -424,9 +399,6 @@ pair_energy(const two_sheet_scale* ts,
   if (ts->layers > 0.0 && layer_pair(ts, p, nj, j, q, ni, i))
     return dacpo_dipole_energy(p, nj, q, ni, 1.0);
   double ce = c;
-  if (band > 0.0 && fabs(plane_offset(p, nj, q)) < band &&
-      fabs(plane_offset(p, ni, q)) < band)
-    ce = 0.0;
   if (ts->c_thin > 0.0 && beyond_noise(ts, p, nj, j, q, ni, i))
     ce = ts->c_thin;
   /* Eq. 4: the field of the (earlier placed) neighbour j acting on i. */
@@ -629,14 +601,6 @@ dipole_neighbors(const double* xyz,
     for (; t < K; ++t)
       row[t] = (int32_t)i;
   }
-  /* Noise band: measurement noise displaces points along the normal, which
-   * Eq. 1 reads as "stacked" (opposite orientation) for large c. Offsets within
-   * the block's noise scale are treated as coplanar; larger ones (a real second
-   * sheet, e.g. the other side of a thin board) keep the full field. */
-  double band = 0.0;
-  if (prm->noise_band > 0.0 && n > 1) {
-    band = prm->noise_band * block_noise_scale(xyz, nrm, n, K, wk->nb, wk->w);
-  }
   two_sheet_scale ts = {NULL, NULL, NULL, 0.0, 0.0, 0.0, 0.0};
   dacpo_status st = thin_part_setup(xyz, nrm, n, K, prm, wk, &ts, err);
   for (size_t i = 0; st == DACPO_OK && i < n; ++i) {
@@ -644,7 +608,7 @@ dipole_neighbors(const double* xyz,
     double* wrow = wk->w + i * K;
     for (size_t t = 0; t < K; ++t) {
       const size_t j = (size_t)row[t];
-      wrow[t] = j == i ? 0.0 : pair_energy(&ts, xyz, nrm, i, j, c, band);
+      wrow[t] = j == i ? 0.0 : pair_energy(&ts, xyz, nrm, i, j, c);
     }
   }
   if (st == DACPO_OK && prm->sides > 0.0)

@@ -18,10 +18,6 @@ typedef struct dacpo_dipole_params {
                        with the highest block energy is kept */
   uint64_t seed;
   uint64_t stream;   /* e.g. the block id: independent of thread count */
-  double noise_band; /* 0 = off; else pairs whose offsets along both normals are
-                        below noise_band * (the block's median RMS offset of
-                        neighbours from a point's tangent plane) count as
-                        coplanar: the c term of Eq. 1 is dropped for them */
   double two_sheet;  /* 0 = off; else pairs on two sheets of one thin part
                         (offsets beyond two_sheet x local noise, see
                         dacpo_params.dipole_two_sheet) must face opposite ways */

@@ -573,20 +573,6 @@ public:
     return params_.keep_mesh != 0;
   }
 
-  /** \brief Noise band of the dipole field (0 = off, default): neighbour pairs whose
-   * offsets along both normals are below this many times the block's noise scale
-   * count as coplanar. */
-  void
-  setDipoleNoiseBand(double band)
-  {
-    params_.dipole_noise_band = band;
-  }
-  /** \brief See setDipoleNoiseBand(). */
-  double
-  getDipoleNoiseBand() const
-  {
-    return params_.dipole_noise_band;
-  }
 
   /** \brief Thin two-sided parts (default -1: by the scan kind, 0 for a single depth
    * view, 3 otherwise; 0 = off): neighbours with parallel axes

@@ -42,7 +42,6 @@ def orient(
     threads: int = ...,
     num_threads: int = ...,
     disconnected: Union[str, int] = ...,
-    dipole_noise_band: float = ...,
     dipole_two_sheet: float = ...,
     dipole_layers: float = ...,
     dipole_sides: float = ...,
