@@ -127,10 +127,15 @@ header_line(pcd_header* h, char* line, int lineno, char* err, size_t errlen)
   if (!strcmp(key, "VERSION") || !strcmp(key, "VIEWPOINT"))
     return 1;
   if (!strcmp(key, "FIELDS") || !strcmp(key, "COLUMNS")) {
+    /* a (repeated) field list needs its SIZE and TYPE lines after it: the
+       sizes of an earlier list do not carry over (a size of 0 was read) */
     h->nf = m - 1;
+    h->have_size = h->have_type = 0;
     for (int i = 0; i < h->nf; ++i) {
       snprintf(h->f[i].name, sizeof(h->f[i].name), "%s", tok[i + 1]);
       h->f[i].count = 1;
+      h->f[i].size = 0;
+      h->f[i].type = 0;
     }
     return 1;
   }
