@@ -42,8 +42,12 @@ dacpo_temp_sibling(const char* path, const char* tag, long id, char* buf, size_t
   const char* slash = strrchr(path, '/');
   const char* name = slash ? slash + 1 : path;
   const size_t dir_len = slash ? (size_t)(slash - path) + 1 : 0;
+  /* the target's extension at the end: writers that choose the format by the
+     name (PCL's) write the right one */
+  const char* dot = strrchr(name, '.');
+  const char* ext = dot && dot != name && strlen(dot) <= 8 ? dot : "";
   char tail[64];
-  const int tl = snprintf(tail, sizeof(tail), ".%s%ld", tag, id);
+  const int tl = snprintf(tail, sizeof(tail), ".%s%ld%s", tag, id, ext);
   const size_t name_len = 1 + strlen(name) + (size_t)tl;
   const size_t total = dir_len + name_len;
   if (!*name || tl <= 0 || name_len > NAME_MAX || total + 1 > PATH_MAX || total + 1 > cap)

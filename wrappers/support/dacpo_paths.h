@@ -30,8 +30,10 @@ int
 dacpo_output_path_check(const char* path, char* err, size_t errlen);
 
 /**
- * \brief The temporary sibling of path: "<dir>/.<name>.<tag><id>" (tag e.g.
- *  "tmp", id the process id, or rank 0's under MPI), never equal to path.
+ * \brief The temporary sibling of path: "<dir>/.<name>.<tag><id><ext>" (tag
+ *  e.g. "tmp", id the process id, or rank 0's under MPI, ext the target's own
+ *  extension, so writers that go by the name write its format), never equal
+ *  to path.
  * \return 0, or -1 (buf holds "") when the name does not fit cap, PATH_MAX or
  *  NAME_MAX.
  */

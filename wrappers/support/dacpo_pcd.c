@@ -44,6 +44,13 @@ dacpo_is_pcd_path(const char* path)
   return len >= 4 && strcasecmp(path + len - 4, ".pcd") == 0;
 }
 
+int
+dacpo_is_ply_path(const char* path)
+{
+  size_t len = path ? strlen(path) : 0;
+  return len >= 4 && strcasecmp(path + len - 4, ".ply") == 0;
+}
+
 /* Strict unsigned number of a header value. */
 static int
 parse_count(const char* s, size_t* out)

@@ -47,6 +47,10 @@ dacpo_pcd_write(const char* path,
 int
 dacpo_is_pcd_path(const char* path);
 
+/** \brief 1 if \a path ends in ".ply" (any case), else 0. */
+int
+dacpo_is_ply_path(const char* path);
+
 /** \brief dacpo_pcd_read() for a .pcd path, dacpo_ply_read() otherwise. */
 int
 dacpo_points_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen);

@@ -23,7 +23,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <time.h>
 
 /* Binary little-endian PLY with double x y z (x scale + offset) and float
@@ -245,8 +244,7 @@ parse_args(int argc, char** argv, const char* prog, make_options* o)
   if (!o->out_path)
     return usage_error(prog, "no output file given", NULL);
   /* the format follows the name: a PLY under a .pcd name crashed PCL readers */
-  const size_t len = strlen(o->out_path);
-  const int ply = len >= 4 && strcasecmp(o->out_path + len - 4, ".ply") == 0;
+  const int ply = dacpo_is_ply_path(o->out_path);
   if (!ply && !dacpo_is_pcd_path(o->out_path))
     return usage_error(prog, "the output must end in .ply or .pcd:", o->out_path);
   if (!ply && o->use_offset)

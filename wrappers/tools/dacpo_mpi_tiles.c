@@ -669,10 +669,8 @@ write_file(tiles_run* t, const char* path)
   for (uint64_t first = t->lo; ok && first < t->hi; first += ROUND_POINTS) {
     const size_t take = (size_t)(t->hi - first < ROUND_POINTS ? t->hi - first : ROUND_POINTS);
     ok = dacpo_ply_rows_read_raw(t->in, &t->rows, first, take, rec, err, sizeof(err)) == 0;
-    for (size_t i = take; ok && i-- > 0;) { /* from the end: rows grow in place */
-      memmove(rec + i * row, rec + i * xb, xb);
-      memcpy(rec + i * row + xb, t->range_nrm + 3 * (first - t->lo + i), 12);
-    }
+    if (ok)
+      dacpo_tiled_append_normals(rec, xb, t->range_nrm + 3 * (first - t->lo), 3, take);
     ok = ok && write_all_at(fh,
                             (MPI_Offset)hlen + (MPI_Offset)(first * row),
                             rec,

@@ -86,6 +86,19 @@ dacpo_tiled_header_typed(char* buf,
                   rows ? dacpo_ply_rows_type_name(rows, 2) : "float");
 }
 
+void
+dacpo_tiled_append_normals(unsigned char* rows,
+                           size_t xyz_bytes,
+                           const float* nrm,
+                           size_t stride,
+                           size_t count)
+{
+  for (size_t i = count; i-- > 0;) { /* from the end: rows grow in place */
+    memmove(rows + i * (xyz_bytes + 12), rows + i * xyz_bytes, xyz_bytes);
+    memcpy(rows + i * (xyz_bytes + 12) + xyz_bytes, nrm + stride * i, 12);
+  }
+}
+
 int
 dacpo_tiled_header(char* buf, size_t len, size_t tiles, uint64_t n)
 {
@@ -587,10 +600,8 @@ rewrite_exact(tiled_run* r, const char* path, char* err, size_t errlen)
     rc = read_at(r->out_fd, rec, take * OUT_BYTES,
                  (off_t)r->header_len + (off_t)(first * OUT_BYTES));
     rc = rc == 0 ? dacpo_ply_rows_read_raw(r->in, &r->rows, first, take, raw, err, errlen) : rc;
-    for (size_t i = take; rc == 0 && i-- > 0;) { /* from the end: rows grow in place */
-      memmove(raw + i * (xb + 12), raw + i * xb, xb);
-      memcpy(raw + i * (xb + 12) + xb, rec + 6 * i + 3, 12);
-    }
+    if (rc == 0)
+      dacpo_tiled_append_normals(raw, xb, rec + 3, 6, take);
     if (rc == 0 && fwrite(raw, xb + 12, take, out) != take)
       rc = -1;
   }

@@ -48,6 +48,16 @@ typedef struct dacpo_tiled_report {
 int
 dacpo_tiled_header(char* buf, size_t len, size_t tiles, uint64_t n);
 
+/* count rows of xyz_bytes (dacpo_ply_rows_read_raw) become rows of xyz_bytes
+ * + 12, the 3 floats at nrm + stride * i appended to row i, in place (rows
+ * holds count x (xyz_bytes + 12) bytes). */
+void
+dacpo_tiled_append_normals(unsigned char* rows,
+                           size_t xyz_bytes,
+                           const float* nrm,
+                           size_t stride,
+                           size_t count);
+
 struct dacpo_ply_rows;
 /* The same with x y z of the input's types (rows; NULL: float), for outputs
  * that keep the input's coordinates bit for bit. */

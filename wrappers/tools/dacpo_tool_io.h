@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dacpo_cleanup.h"
+#include "dacpo_paths.h"
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
@@ -1276,13 +1277,13 @@ template <typename Produce>
 bool
 writeAtomically(const std::string& path, Produce produce, std::string& error)
 {
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir =
-      slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
-  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
-  const std::string tmp = dir + "." + base + ".tmp" +
-                          std::to_string(static_cast<long>(::getpid())) +
-                          extension(path);
+  char name[4352];
+  if (dacpo_temp_sibling(path.c_str(), "tmp", static_cast<long>(::getpid()), name,
+                         sizeof(name)) != 0) {
+    error = "'" + path + "': name too long for a temporary file beside it";
+    return false;
+  }
+  const std::string tmp = name;
   /* a SIGINT or SIGTERM while it is written removes it (dacpo_cleanup.h) */
   const int slot = dacpo_cleanup_add(tmp.c_str());
   const bool ok = produce(tmp, error) && syncFile(tmp, error);

@@ -130,8 +130,7 @@ positive(const char* text, double* out, const char* name, char* msg, size_t msg_
 static int
 check_outputs(const options* o, char* msg, size_t msg_size)
 {
-  const size_t ol = strlen(o->out);
-  if (!dacpo_is_pcd_path(o->out) && (ol < 4 || strcmp(o->out + ol - 4, ".ply") != 0)) {
+  if (!dacpo_is_pcd_path(o->out) && !dacpo_is_ply_path(o->out)) {
     snprintf(msg, msg_size, "the output must be a .ply or .pcd file, got %s", o->out);
     return 0;
   }
@@ -687,7 +686,7 @@ write_output(const char* path, dacpo_ply_cloud* cloud)
 static int
 tiled_main(const options* o, int rank, int ranks)
 {
-  if (strlen(o->out) < 4 || strcmp(o->out + strlen(o->out) - 4, ".ply") != 0) {
+  if (!dacpo_is_ply_path(o->out)) {
     if (rank == 0)
       fprintf(stderr, "Error: -tiles / -memory write a .ply, got %s\n", o->out);
     MPI_Finalize();
