@@ -8,9 +8,10 @@
 #   xvfb            virtual X server for pcl_viewer screenshots (bench/render.sh)
 #   imagemagick     montage of the two renders side by side
 #   time            /usr/bin/time -v for wall time and peak RSS of every run
+#   python3-matplotlib  the plots of bench/report.sh
 set -euo pipefail
 
-PACKAGES=(python3-open3d libcgal-dev xvfb xauth imagemagick time)
+PACKAGES=(python3-open3d libcgal-dev xvfb xauth imagemagick time python3-matplotlib)
 
 "$(dirname "${BASH_SOURCE[0]}")/apt_install.sh" install_bench_deps --no-install-recommends \
   "${PACKAGES[@]}"

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
 """Peer method for the pcl_dacpo benchmark: Open3D's normal orientation.
 
