@@ -46,6 +46,9 @@ def parse():
     ap.add_argument("--suite", action="append", default=[], help="NAME=DIR (repeatable)")
     ap.add_argument("--seeds", default="1,2,3,4,5")
     ap.add_argument("--sizes", default="50000,100000,200000,500000")
+    ap.add_argument("--time-limit", type=float, default=120.0,
+                    help="seconds per scaling run; a method that takes longer is not run on "
+                         "larger rooms (Open3D's MST is far superlinear on exactly planar rooms)")
     ap.add_argument("--no-render", action="store_true", help="keep the pictures as they are")
     ap.add_argument("--no-readme", action="store_true", help="write report.md only")
     ap.add_argument("--rewrite", action="store_true",
@@ -145,9 +148,9 @@ def accuracy(opt, found, suite_list):
     return res
 
 
-def timed(cmd):
-    """(wall s, peak RSS MB, rc) of one run under /usr/bin/time."""
-    r = run(["/usr/bin/time", "-f", "TIME %e %M"] + cmd)
+def timed(cmd, limit):
+    """(wall s, peak RSS MB, rc) of one run under /usr/bin/time; rc 124 past limit."""
+    r = run(["/usr/bin/time", "-f", "TIME %e %M", "timeout", str(limit)] + cmd)
     m = re.findall(r"TIME ([0-9.]+) ([0-9]+)", r.stderr)
     if not m:
         return None, None, r.returncode or 1
@@ -156,7 +159,7 @@ def timed(cmd):
 
 def scaling(opt, found):
     """[{points, method: {wall, rss, wrong}}] on generated rooms of growing size."""
-    rows = []
+    rows, over = [], set()
     d = os.path.join(opt.work, "scaling")
     os.makedirs(d, exist_ok=True)
     for n in [int(s) for s in opt.sizes.split(",") if s]:
@@ -168,10 +171,15 @@ def scaling(opt, found):
         for key, _, prog in METHODS:
             if key not in found:
                 continue
+            if key in over:
+                row[key] = dict(wall=None, rss=None, wrong=None, rc=124, skipped=True)
+                continue
             pred = os.path.join(d, f"pred_{key}.ply")
             cmd = [found[key], room, pred] if found[key] else \
                 [os.path.join(opt.tools, "pcl_dacpo_orient"), room, pred, "-estimate", "-q"]
-            wall, rss, rc = timed(cmd)
+            wall, rss, rc = timed(cmd, opt.time_limit)
+            if rc == 124:
+                over.add(key)
             wrong = None
             if rc == 0:
                 ev = run([os.path.join(opt.tools, "pcl_dacpo_eval"), room, pred, "-json"])
@@ -264,6 +272,7 @@ def fmt(v, spec=".2f"):
 def markdown(opt, acc, sc, pngs, pictures, command, stamp):
     names = dict((k, l) for k, l, _ in METHODS)
     seeds = len([s for s in opt.seeds.split(",") if s])
+    command = re.sub(r"(--suite [\w.-]+)=\S+", r"\1=DIR", command)
     L = [f"Measured {stamp}; `{command}`.", "",
          f"**Error per suite** (% of normals wrong after one global sign flip, the paper's metric; "
          f"per file the median over seeds {opt.seeds} for pcl_dacpo, one run for the deterministic peers; "
@@ -306,13 +315,22 @@ def markdown(opt, acc, sc, pngs, pictures, command, stamp):
                      f"{r['in_block']:.2f} / {r['flip']:.2f} | " + " | ".join(peers) + " |")
     L += ["", "</details>", ""]
     keys = [k for k, _, _ in METHODS if any(k in r for r in sc)]
+    limit = getattr(opt, "time_limit", None) or 120.0
+
+    def cell(m, limit):
+        if m.get("skipped"):
+            return "not run (slower before)"
+        if m["rc"] == 124:
+            return f"> {limit:.0f} s"
+        if m["rc"]:
+            return "failed"
+        return f"{fmt(m['wall'], '.1f')} s / {fmt(m['rss'], '.0f')} MB / {fmt(m['wrong'])} %"
     L += ["**Time and peak memory against points** (generated room, scene seed 1; end to end: read, "
           "orient, write; pcl_dacpo on all cores, the peers as they run; cell = wall s / peak RSS MB / "
-          "% wrong):", "",
+          f"% wrong; {limit:.0f} s at most per run):", "",
           "| points | " + " | ".join(names[k] for k in keys) + " |", "|---:|" + "---:|" * len(keys)]
     for r in sc:
-        cells = [("failed" if r[k]["rc"] else f"{fmt(r[k]['wall'], '.1f')} s / {fmt(r[k]['rss'], '.0f')} MB / "
-                  f"{fmt(r[k]['wrong'])} %") if k in r else "—" for k in keys]
+        cells = [cell(r[k], limit) if k in r else "—" for k in keys]
         L.append(f"| {r['points']:,} | " + " | ".join(cells) + " |")
     L.append("")
     for p in pngs:

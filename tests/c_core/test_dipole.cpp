@@ -78,7 +78,6 @@ pipeline_params()
   dacpo_dipole_params p = default_params();
   p.c = 1.5;
   p.restarts = 16;
-  p.restart_vote = 1;
   p.final_sweep = 10;
   p.two_sheet = 3.0;
   return p;
@@ -481,12 +480,9 @@ TEST(DacpoDipole, IslandsOfABlockTakeTheFieldOfThePlacedPoints)
               a.truth[3 * i + 1],
               a.truth[3 * i + 2]);
     s.scramble(seed);
-    for (int vote = 0; vote <= 1; ++vote) {
-      dacpo_dipole_params p = pipeline_params();
-      p.seed = seed;
-      p.restart_vote = vote;
-      EXPECT_EQ(orient_score(s, p), 1.0) << seed << " vote " << vote;
-    }
+    dacpo_dipole_params p = pipeline_params();
+    p.seed = seed;
+    EXPECT_EQ(orient_score(s, p), 1.0) << seed;
   }
 }
 
@@ -599,26 +595,20 @@ TEST(DacpoDipole, TimingReport)
 TEST(DacpoDipole, RestartVoteHoldsOnEverySeed)
 {
   // Shelves on a panel without the side cue: the boards' relation to the panel
-  // is weak, and which restart has the highest block energy is close to a coin
-  // toss. Measured over run seeds 1-8 (8 restarts): keeping the highest-energy
-  // restart gave 0.686-0.921 right (mean 0.850), the point-wise vote
-  // 0.857-0.918 (mean 0.891).
+  // is weak, and which single restart gets it right is close to a coin toss.
+  // The point-wise vote of 8 restarts holds on every run seed (measured
+  // 0.857-0.918 right over seeds 1-8; keeping the restart with the highest
+  // block energy, an option until 2026-12-04, gave 0.686-0.921).
   const Shape s = shelves_on_panel(4, 0.01, 3);
   dacpo_dipole_params p = pipeline_params();
   p.restarts = 8;
-  double lo[2] = {1.0, 1.0}, hi[2] = {0.0, 0.0}, mean[2] = {0.0, 0.0};
-  for (int vote = 0; vote <= 1; ++vote) {
-    p.restart_vote = vote;
-    for (uint64_t seed = 1; seed <= 8; ++seed) {
-      p.seed = seed;
-      const double right = orient_score(s, p);
-      lo[vote] = std::min(lo[vote], right);
-      hi[vote] = std::max(hi[vote], right);
-      mean[vote] += right / 8.0;
-    }
+  double lo = 1.0, hi = 0.0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    p.seed = seed;
+    const double right = orient_score(s, p);
+    lo = std::min(lo, right);
+    hi = std::max(hi, right);
   }
-  EXPECT_GE(lo[1], 0.85);
-  EXPECT_LE(hi[1] - lo[1], 0.08);
-  EXPECT_GT(mean[1], mean[0]);
-  EXPECT_GT(lo[1], lo[0]);
+  EXPECT_GE(lo, 0.85);
+  EXPECT_LE(hi - lo, 0.08);
 }

@@ -537,6 +537,25 @@ TEST(DACPONormalOrientation, SettersRoundTrip)
   EXPECT_EQ(d.getNumberOfThreads(), 0u);
 }
 
+// setParameter takes any row of the parameter table by name, as the CLI does.
+TEST(DACPONormalOrientation, SetParameterByName)
+{
+  using Orientation = pcl::DACPONormalOrientation<pcl::PointXYZ, pcl::Normal>;
+  Orientation d;
+  std::string error;
+  EXPECT_TRUE(d.setParameter("dipole_c", "2", &error)) << error;
+  EXPECT_EQ(d.getDipoleC(), 2.0);
+  EXPECT_TRUE(d.setParameter("k", "14", &error)) << error;
+  EXPECT_EQ(d.getKSearch(), 14);
+  EXPECT_TRUE(d.setParameter("edge_weight", "dipole", &error)) << error;
+  EXPECT_EQ(d.getEdgeWeight(), Orientation::EdgeWeight::DipoleBoundary);
+  EXPECT_FALSE(d.setParameter("dipole_c", "two", &error));
+  EXPECT_NE(error.find("dipole_c"), std::string::npos) << error;
+  EXPECT_EQ(d.getDipoleC(), 2.0);
+  EXPECT_FALSE(d.setParameter("no_such_field", "1", &error));
+  EXPECT_NE(error.find("no_such_field"), std::string::npos) << error;
+}
+
 } // namespace
 
 namespace {

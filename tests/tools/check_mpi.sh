@@ -46,6 +46,12 @@ check_scene() { # name, make_scene args..., -- tool args...
 
 # a room with estimated normals, seed 3, 11 blocks over 3 ranks
 MAX=10 check_scene room -scene room -n 20000 -seed 4 -- -estimate -seed 3 -blocks 11
+# the method's options come from the parameter table (as pcl_dacpo_orient's):
+# the same bytes for 1-3 ranks, and they do change the answer
+MAX=10 check_scene room_opts -scene room -n 20000 -seed 4 -- -estimate -seed 3 -blocks 11 \
+  -c 2 -restarts 4 -seam_dipole 0
+! cmp -s "$W/room_whole.ply" "$W/room_opts_whole.ply" ||
+  fail "room: -c 2 -restarts 4 -seam_dipole 0 gave the default's bytes"
 # the spread neighbour search (-spread_knn): 2 and 3 ranks, a first halo far
 # too thin, widened round by round (every rank's rows checked), and a cloud of
 # six copies of every point (more duplicates than the gathered rows hold: rank
@@ -95,8 +101,13 @@ set -e
 set +e
 out=$(run 2 "$W/room.ply" "$W/x.ply" -blocks many 2>&1); st=$?
 set -e
-[ "$st" -ne 0 ] && grep -q "unknown option or missing number" <<< "$out" ||
+[ "$st" -ne 0 ] && grep -q "\-blocks many (num_blocks: 'many' is not a value it takes)" <<< "$out" ||
   fail "bad option: status $st: $out"
+set +e
+out=$(run 2 "$W/room.ply" "$W/x.ply" -no_such_option 3 2>&1); st=$?
+set -e
+[ "$st" -ne 0 ] && grep -q "unknown option or missing number: -no_such_option" <<< "$out" ||
+  fail "unknown option: status $st: $out"
 [ ! -e "$W/x.ply" ] || fail "a failed run left an output file"
 set +e
 out=$(run 2 "$W/room.ply" "$W/no_such_dir/x.ply" -q 2>&1); st=$?

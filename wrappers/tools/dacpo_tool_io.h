@@ -243,6 +243,34 @@ applyOptions(const Spec (&table)[N], int argc, char** argv, Options& o)
   return true;
 }
 
+/** Help lines wrap at this many characters (the parameter table's one-line
+ *  docs; hand-written helps break their own lines with '\n'). */
+constexpr std::size_t kHelpWidth = 56;
+
+/** \a text with every line longer than \a width broken at its last space
+ *  before that width. */
+inline std::string
+wrapHelp(const std::string& text, std::size_t width)
+{
+  std::string out;
+  std::size_t line_start = 0;
+  for (char c : text) {
+    out += c;
+    if (c == '\n') {
+      line_start = out.size();
+      continue;
+    }
+    if (out.size() - line_start > width) {
+      const std::size_t space = out.rfind(' ');
+      if (space != std::string::npos && space > line_start) {
+        out[space] = '\n';
+        line_start = space + 1;
+      }
+    }
+  }
+  return out;
+}
+
 /** The options part of -h, one entry per option: 21 spaces, the name and the
  *  value's placeholder padded to \a head_width, " = ", the help with its
  *  continuation lines indented by \a indent, and the default if shown. */
@@ -259,7 +287,7 @@ printOptionTable(const Spec (&table)[N],
       head += std::string(" ") + spec.arg;
     if (head.size() < head_width)
       head.resize(head_width, ' ');
-    std::string text = spec.help;
+    std::string text = wrapHelp(spec.help, kHelpWidth);
     for (std::size_t at = text.find('\n'); at != std::string::npos;
          at = text.find('\n', at + 1))
       text.insert(at + 1, indent, ' ');

@@ -8,6 +8,7 @@
  * 0-1 program flipped it). A last "stats: ..." line (also with -q) gives the
  * counts, time and peak memory. */
 #include <dacpo/dacpo.h>
+#include <dacpo/dacpo_param_table.h>
 
 #include <pcl_dacpo/dacpo_normal_orientation.h>
 
@@ -152,57 +153,35 @@ showNumber(const dacpo_params& d)
   return out.str();
 }
 
+/* Options generated from the parameter table (dacpo_param_table.h): a VALUE
+ * row is "flag X" with the row's doc as its help; SPECIAL rows are written
+ * below by hand, NONE rows have no option. */
+#define DACPO_CLI_SET_SIZE(name) setUnsigned<size_t, &dacpo_params::name>
+#define DACPO_CLI_SET_U64(name) setUnsigned<std::uint64_t, &dacpo_params::name>
+#define DACPO_CLI_SET_UINT(name) setUnsigned<unsigned, &dacpo_params::name>
+#define DACPO_CLI_SET_INT(name) setUnsigned<int, &dacpo_params::name>
+#define DACPO_CLI_SET_FLAG(name) setUnsigned<int, &dacpo_params::name>
+#define DACPO_CLI_SET_REAL(name) setDouble<&dacpo_params::name>
+#define DACPO_CLI_VALUE(kind, name, flag, doc)                                           \
+  {flag,                                                                                 \
+   "X",                                                                                  \
+   doc,                                                                                  \
+   showNumber<decltype(dacpo_params::name), &dacpo_params::name>,                        \
+   DACPO_CLI_SET_##kind(name)},
+#define DACPO_CLI_SPECIAL(kind, name, flag, doc)
+#define DACPO_CLI_NONE(kind, name, flag, doc)
+
 const OptionSpec kOptions[] = {
-    {"-k",
-     "X",
-     "neighbours of the k-NN graph",
-     showNumber<size_t, &dacpo_params::k>,
-     setUnsigned<size_t, &dacpo_params::k>},
-    {"-normal_k",
-     "X",
-     "neighbours of PCA normals when estimated",
-     showNumber<size_t, &dacpo_params::normal_k>,
-     setUnsigned<size_t, &dacpo_params::normal_k>},
-    {"-normal_weight",
-     "X",
-     "estimated normals: neighbours weigh exp(-d^2/h^2), h = X x the\n"
-     "distance of the middle one of normal_k; 0 = unweighted (1.5\n"
-     "helps rooms with thin furniture)",
-     showNumber<double, &dacpo_params::normal_weight>,
-     setDouble<&dacpo_params::normal_weight>},
-    {"-adaptive_normals",
-     "X",
-     "estimated normals: 1 = per point the flattest of 3/4, 1 and 3/2 x\n"
-     "normal_k neighbours (sparse rooms, thin parts); 0 = normal_k alone",
-     showNumber<int, &dacpo_params::adaptive_normals>,
-     setUnsigned<int, &dacpo_params::adaptive_normals>},
+    /* every VALUE row of the parameter table: "flag X" */
+#define DACPO_PARAM(kind, name, def, who, cli, flag, doc) DACPO_CLI_##cli(kind, name, flag, doc)
+    DACPO_PARAMS()
+#undef DACPO_PARAM
     {"-estimate",
      nullptr,
      "estimate PCA normals even if the input has normal_x/y/z\n"
      "(without normals in the input they are always estimated)",
      nullptr,
      setFlag<&Options::estimate>},
-    {"-blocks",
-     "X",
-     "number of blocks, 0 = automatic",
-     showNumber<size_t, &dacpo_params::num_blocks>,
-     setUnsigned<size_t, &dacpo_params::num_blocks>},
-    {"-c",
-     "X",
-     "dipole constant c (paper Eq. 1), >= 1: 4 clean, 2 noisy;\n"
-     "-1 = by the scan kind (1 single view, 1.5 otherwise)",
-     showNumber<double, &dacpo_params::dipole_c>,
-     setDouble<&dacpo_params::dipole_c>},
-    {"-vcr_size",
-     "X",
-     "VCR image side in pixels",
-     showNumber<size_t, &dacpo_params::vcr_image_size>,
-     setUnsigned<size_t, &dacpo_params::vcr_image_size>},
-    {"-vcr_views",
-     "X",
-     "VCR views",
-     showNumber<size_t, &dacpo_params::vcr_views>,
-     setUnsigned<size_t, &dacpo_params::vcr_views>},
     {"-vcr_perspective",
      nullptr,
      "perspective VCR projection (default: orthographic)",
@@ -296,13 +275,6 @@ const OptionSpec kOptions[] = {
        o.separate = true;
        return true;
      }},
-    {"-weak",
-     "X",
-     "block edges with less than X times the typical evidence\n"
-     "leave their blocks to the viewpoint vote, 0 = only\n"
-     "disconnected parts (with tiles the default is 0)",
-     showNumber<double, &dacpo_params::weak_edge_fraction>,
-     setDouble<&dacpo_params::weak_edge_fraction>},
     {"-bridge",
      nullptr,
      "join disconnected parts along their minimum spanning tree\n"
@@ -312,29 +284,6 @@ const OptionSpec kOptions[] = {
        o.bridge = true;
        return true;
      }},
-    {"-two_sheet",
-     "X",
-     "thin parts: neighbours off each other's tangent plane by\n"
-     "more than X times the local noise are two sheets that\n"
-     "face opposite ways, 0 = off, -1 = by the scan kind\n"
-     "(0 single view, 3 otherwise)",
-     showNumber<double, &dacpo_params::dipole_two_sheet>,
-     setDouble<&dacpo_params::dipole_two_sheet>},
-    {"-c_thin",
-     "X",
-     "thin parts: in blocks with two-sided parts, pairs off each\n"
-     "other's tangent plane beyond the two-sheet noise test use\n"
-     "dipole constant X (paper: 4 for clean data), 0 = off",
-     showNumber<double, &dacpo_params::dipole_c_thin>,
-     setDouble<&dacpo_params::dipole_c_thin>},
-    {"-layers",
-     "X",
-     "layered one-sided surfaces: parallel neighbours off each\n"
-     "other's tangent plane by more than X local spacings are\n"
-     "layers of one surface (no \"opposite\" vote), 0 = off,\n"
-     "-1 = by the scan kind (0.5 single view, 2 otherwise)",
-     showNumber<double, &dacpo_params::dipole_layers>,
-     setDouble<&dacpo_params::dipole_layers>},
     {"-scan",
      "auto|single|multi",
      "kind of scan: one depth view (single: layers face one way,\n"
@@ -358,54 +307,6 @@ const OptionSpec kOptions[] = {
        }
        return true;
      }},
-    {"-sides",
-     "X",
-     "thin parts under one spacing: weight of the side cue (the\n"
-     "point's face, from two clusters of offsets off one fitted\n"
-     "quadric) against its pair energies, 0 = off",
-     showNumber<double, &dacpo_params::dipole_sides>,
-     setDouble<&dacpo_params::dipole_sides>},
-    {"-cue_anchor",
-     "X",
-     "weight that ties a block where the side cue fired to the\n"
-     "sign the cue gives it in the 0-1 program, 0 = off",
-     showNumber<double, &dacpo_params::cue_anchor>,
-     setDouble<&dacpo_params::cue_anchor>},
-    {"-seam_dipole",
-     "X",
-     "VCR block edges: add the dipole energy across the block\n"
-     "seam as a second measure with this weight (each in units\n"
-     "of its typical edge), 0 = VCR alone",
-     showNumber<double, &dacpo_params::seam_dipole>,
-     setDouble<&dacpo_params::seam_dipole>},
-    {"-surface_vote",
-     "X",
-     "after the 0-1 program: smooth surfaces of at least X points\n"
-     "turn their minority over (blocks a junction left inside\n"
-     "out), 0 = off",
-     showNumber<size_t, &dacpo_params::surface_vote>,
-     setUnsigned<size_t, &dacpo_params::surface_vote>},
-    {"-orders",
-     "X",
-     "randomized dipole propagation orders",
-     showNumber<size_t, &dacpo_params::dipole_orders>,
-     setUnsigned<size_t, &dacpo_params::dipole_orders>},
-    {"-restarts",
-     "X",
-     "dipole runs per block",
-     showNumber<size_t, &dacpo_params::dipole_restarts>,
-     setUnsigned<size_t, &dacpo_params::dipole_restarts>},
-    {"-restart_vote",
-     "X",
-     "1: the runs are voted point by point; 0: the run with the\n"
-     "highest block energy (Eq. 4 over all pairs) is kept",
-     showNumber<int, &dacpo_params::dipole_restart_vote>,
-     setUnsigned<int, &dacpo_params::dipole_restart_vote>},
-    {"-ring",
-     "X",
-     "block overlap ring in k-NN hops",
-     showNumber<size_t, &dacpo_params::ring_hops>,
-     setUnsigned<size_t, &dacpo_params::ring_hops>},
     {"-no_ipsr",
      nullptr,
      "skip the iterative Poisson refinement",
@@ -433,33 +334,6 @@ const OptionSpec kOptions[] = {
          error = "must be vcr, dipole or overlap, got '" + s + "'";
          return false;
        }
-       return true;
-     }},
-    {"-time_limit",
-     "X",
-     "seconds for the 0-1 program",
-     showNumber<double, &dacpo_params::solver_time_limit>,
-     setDouble<&dacpo_params::solver_time_limit>},
-    {"-seed",
-     "X",
-     "random seed",
-     showNumber<std::uint64_t, &dacpo_params::seed>,
-     setUnsigned<std::uint64_t, &dacpo_params::seed>},
-    {"-threads",
-     "X",
-     "worker threads, 0 = all cores",
-     showNumber<unsigned, &dacpo_params::num_threads>,
-     [](Options& o, const std::string& s, std::string& error) {
-       std::uint64_t v = 0;
-       if (!toUnsigned(s, v)) {
-         error = "expects a non-negative integer, got '" + s + "'";
-         return false;
-       }
-       if (v > 4096) {
-         error = s + " is too large";
-         return false;
-       }
-       o.params.num_threads = static_cast<unsigned>(v);
        return true;
      }},
     {"-labels",

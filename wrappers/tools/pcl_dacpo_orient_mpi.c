@@ -3,9 +3,9 @@
  * pcl_dacpo_orient_mpi: dacpo_orient() with its block and edge units spread
  * over MPI ranks (dacpo_advanced.h). Plain C; MPI only here, never in the core.
  *
- *   mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] [-seed S]
- *          [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] [-spread_knn]
- *          [-knn_halo H] [-report F] [-q]
+ *   mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] [-whole]
+ *          [-spread_knn] [-knn_halo H] [-tiles P | -memory X] [-tile_halo H]
+ *          [-report F] [-q] [every "-flag X" of the parameter table: -k, -c, ...]
  *
  * Rank 0 reads the cloud and runs stages 0-1 (k-NN graph, normals, blocks;
  * -spread_knn: the k-NN search spread over the ranks, dacpo_mpi_knn.h: one
@@ -41,6 +41,7 @@
 
 #include <dacpo/dacpo.h>
 #include <dacpo/dacpo_advanced.h>
+#include <dacpo/dacpo_param_table.h>
 
 #include "dacpo_mpi_comm.h"
 #include "dacpo_mpi_knn.h"
@@ -138,6 +139,22 @@ check_outputs(const options* o, char* msg, size_t msg_size)
          (!o->report || dacpo_output_path_check(o->report, msg, msg_size) == 0);
 }
 
+/* The dacpo_params field an option of the parameter table sets (its VALUE
+ * rows, as pcl_dacpo_orient takes them), or NULL. */
+static const char*
+param_option(const char* flag)
+{
+#define DACPO_MPI_VALUE(name, f)                                               \
+  if (!strcmp(flag, f))                                                        \
+    return #name;
+#define DACPO_MPI_SPECIAL(name, f)
+#define DACPO_MPI_NONE(name, f)
+#define DACPO_PARAM(kind, name, def, who, cli, f, doc) DACPO_MPI_##cli(name, f)
+  DACPO_PARAMS()
+#undef DACPO_PARAM
+  return NULL;
+}
+
 static int
 parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
 {
@@ -174,22 +191,17 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
     }
     else if (!strcmp(a, "-report") && has_value)
       o->report = argv[++i];
-    else if (a[0] == '-' && has_value && parse_size(argv[i + 1], &v)) {
-      ++i;
-      if (!strcmp(a, "-seed"))
-        o->p.seed = v;
-      else if (!strcmp(a, "-blocks"))
-        o->p.num_blocks = v;
-      else if (!strcmp(a, "-k"))
-        o->p.k = v;
-      else if (!strcmp(a, "-normal_k"))
-        o->p.normal_k = v;
-      else if (!strcmp(a, "-threads"))
-        o->p.num_threads = (unsigned)v;
-      else if (!strcmp(a, "-tiles") && v >= 16)
-        o->tile_points = v;
-      else {
-        snprintf(msg, msg_size, "unknown option %s", a);
+    else if (!strcmp(a, "-tiles") && has_value) {
+      if (!parse_size(argv[++i], &v) || v < 16) {
+        snprintf(msg, msg_size, "-tiles needs a point count >= 16, got %s", argv[i]);
+        return 0;
+      }
+      o->tile_points = v;
+    }
+    else if (param_option(a) && has_value) {
+      char why[200] = "";
+      if (dacpo_params_set(&o->p, param_option(a), argv[++i], why, sizeof(why)) != DACPO_OK) {
+        snprintf(msg, msg_size, "%s %s (%s)", a, argv[i], why);
         return 0;
       }
     }
@@ -211,8 +223,8 @@ parse_args(int argc, char** argv, options* o, char* msg, size_t msg_size)
         msg,
         msg_size,
         "usage: mpirun -np R pcl_dacpo_orient_mpi in.ply|pcd out.ply|pcd [-estimate] "
-        "[-seed S] [-blocks B] [-k K] [-normal_k K] [-threads T] [-whole] "
-        "[-spread_knn] [-knn_halo H] [-report F] [-q]");
+        "[-whole] [-spread_knn] [-knn_halo H] [-tiles P | -memory X] [-report F] [-q] "
+        "[-k K -c C -seed S ...: -h lists them]");
     return 0;
   }
   if (dacpo_params_validate(&o->p, msg, msg_size) != DACPO_OK)
@@ -735,6 +747,49 @@ tiled_main(const options* o, int rank, int ranks)
   return ok ? 0 : 2;
 }
 
+/* "  -flag X  doc (default: v)" for every VALUE row of the parameter table,
+ * the doc wrapped at 64 columns. */
+#define DACPO_MPI_FMT_SIZE(v) "%zu", (v)
+#define DACPO_MPI_FMT_REAL(v) "%g", (v)
+#define DACPO_MPI_FMT_FLAG(v) "%d", (v)
+#define DACPO_MPI_FMT_INT(v) "%d", (v)
+#define DACPO_MPI_FMT_UINT(v) "%u", (v)
+#define DACPO_MPI_FMT_U64(v) "%llu", (unsigned long long)(v)
+
+static void
+print_param_line(const char* flag, const char* doc, const char* def)
+{
+  printf("  %-18s", flag);
+  size_t col = 20;
+  const char* w = doc;
+  while (*w) {
+    size_t len = strcspn(w, " ");
+    if (col + len > 78) {
+      printf("\n%20s", "");
+      col = 20;
+    }
+    printf("%.*s%s", (int)len, w, w[len] ? " " : "");
+    col += len + 1;
+    w += len + (w[len] ? 1 : 0);
+  }
+  printf(" (default: %s)\n", def);
+}
+
+static void
+print_param_options(const dacpo_params* d)
+{
+  char def[64];
+#define DACPO_MPI_HELP_VALUE(kind, name, f, doc)                               \
+  snprintf(def, sizeof(def), DACPO_MPI_FMT_##kind(d->name));                   \
+  print_param_line(f " X", doc, def);
+#define DACPO_MPI_HELP_SPECIAL(kind, name, f, doc)
+#define DACPO_MPI_HELP_NONE(kind, name, f, doc)
+#define DACPO_PARAM(kind, name, def_, who, cli, f, doc)                        \
+  DACPO_MPI_HELP_##cli(kind, name, f, doc)
+  DACPO_PARAMS()
+#undef DACPO_PARAM
+}
+
 static void
 print_help(void)
 {
@@ -747,12 +802,6 @@ print_help(void)
       "Options:\n"
       "  -estimate     estimate PCA normals even when the file has nx ny nz (without\n"
       "                them they are always estimated)\n"
-      "  -seed S       random seed (default: %llu)\n"
-      "  -blocks B     target number of blocks, 0 = automatic (default: 0)\n"
-      "  -k K          k-NN graph size (default: %zu)\n"
-      "  -normal_k K   PCA neighbourhood (default: %zu)\n"
-      "  -threads T    threads of rank 0's stages 0-1 (default: 1); the units run one\n"
-      "                per rank\n"
       "  -whole        rank 0 runs dacpo_orient() alone (for comparison)\n"
       "  -spread_knn   stage 0's neighbour search spread over the ranks (one slab of\n"
       "                the cloud per rank, with a halo); default: rank 0 alone with\n"
@@ -781,10 +830,10 @@ print_help(void)
       "As root, Open MPI needs --allow-run-as-root (or OMPI_ALLOW_RUN_AS_ROOT=1\n"
       "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1).\n"
       "Exit status: 0 success, 1 bad arguments, 2 reading, orienting or writing "
-      "failed.\n",
-      (unsigned long long)d.seed,
-      d.k,
-      d.normal_k);
+      "failed.\n");
+  d.num_threads = 1; /* rank 0's stages 0-1; the units run one per rank */
+  printf("\nThe method's parameters (as pcl_dacpo_orient takes them):\n");
+  print_param_options(&d);
 }
 
 int

@@ -184,12 +184,8 @@ typedef struct dacpo_params {
   int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
   int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
   size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
-                                      each), 1..64 (16); voted runs stop after 4
-                                      that all agree */
-  int dipole_restart_vote;       /**< 1: the restarts are voted point by point (each
-                                      flipped as a whole to agree with the vote);
-                                      0: the restart with the highest block energy
-                                      (Eq. 4 summed over all pairs) is kept (1) */
+                                      each, voted point by point), 1..64 (16);
+                                      they stop after 4 that all agree */
   double weak_edge_fraction;     /**< VIEWPOINT policy: block-graph edges whose
                                       alpha + alpha-bar is below this fraction of the
                                       median edge's do not join blocks into one part;
@@ -252,10 +248,6 @@ typedef struct dacpo_params {
                                       Eq. 1 with this c (the paper's clean-data
                                       value) instead of dipole_c. Blocks seen from
                                       one side keep dipole_c. 0 = off (4) */
-  double normal_weight;          /**< estimated normals: neighbours weigh
-                                      exp(-d^2 / h^2) in the PCA, h = this x
-                                      the distance of the middle one of the
-                                      normal_k; 0 = unweighted (0) */
   int adaptive_normals;          /**< estimated normals: 1 = per point the
                                       neighbourhood among 3/4, 1 and 3/2 x
                                       normal_k that is flattest (lowest
@@ -300,6 +292,24 @@ dacpo_params_init(dacpo_params* params);
  */
 DACPO_API dacpo_status
 dacpo_params_validate(const dacpo_params* params, char* message, size_t message_size);
+
+/**
+ * \brief Set the field called \a name (a dacpo_params field, e.g. "dipole_c")
+ * from its text \a value: a number for numeric fields, 0 or 1 for flags, the
+ * value's name in lower case for enums (edge_weight: dipole, vcr, overlap;
+ * disconnected: separate, error, bridge, viewpoint; sign_policy: free_space,
+ * viewpoint, keep; scan_kind: auto, single, multi). Every field of
+ * dacpo_param_table.h can be set this way (viewpoint cannot). The value must
+ * fit the field's type; its range is checked by dacpo_params_validate().
+ * Returns DACPO_OK, or DACPO_ERR_INVALID_ARGUMENT (unknown name, value that
+ * does not parse; \a params unchanged) with a text naming both in \a message.
+ */
+DACPO_API dacpo_status
+dacpo_params_set(dacpo_params* params,
+                 const char* name,
+                 const char* value,
+                 char* message,
+                 size_t message_size);
 
 /**
  * \brief Neighbour search supplied by the caller (e.g. a PCL KdTree).

@@ -6,7 +6,11 @@
 
 #include <dacpo/dacpo_param_table.h>
 
+#include <ctype.h>
+#include <errno.h>
+#include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -73,7 +77,7 @@ dacpo_params_init(dacpo_params* p)
     return;
   memset(p, 0, sizeof(*p)); /* viewpoint (0, 0, 0) */
   /* every default from the one table (dacpo_param_table.h) */
-#define DACPO_PARAM(kind, name, def, who) p->name = def;
+#define DACPO_PARAM(kind, name, def, who, cli, flag, doc) p->name = def;
   DACPO_PARAMS()
 #undef DACPO_PARAM
 }
@@ -88,6 +92,102 @@ bad_field(char* message, size_t size, const char* fmt, ...)
     va_end(ap);
   }
   return DACPO_ERR_INVALID_ARGUMENT;
+}
+
+/* The names dacpo_params_set takes for each enum field, in value order. */
+static const char* const names_edge_weight[] = {"dipole", "vcr", "overlap"};
+static const char* const names_disconnected[] = {"separate", "error", "bridge", "viewpoint"};
+static const char* const names_sign_policy[] = {"free_space", "viewpoint", "keep"};
+static const char* const names_scan_kind[] = {"auto", "single", "multi"};
+
+/* Whole-text integer in [lo, hi]. */
+static int
+parse_integer(const char* text, long long lo, unsigned long long hi, unsigned long long* out)
+{
+  if (!text || !*text || isspace((unsigned char)*text))
+    return 0;
+  char* end = NULL;
+  errno = 0;
+  if (text[0] == '-') {
+    const long long v = strtoll(text, &end, 10);
+    if (errno || *end || v < lo)
+      return 0;
+    *out = (unsigned long long)v;
+    return 1;
+  }
+  const unsigned long long v = strtoull(text, &end, 10);
+  if (errno || *end || v > hi)
+    return 0;
+  *out = v;
+  return 1;
+}
+
+static int
+parse_real(const char* text, double* out)
+{
+  if (!text || !*text || isspace((unsigned char)*text))
+    return 0;
+  char* end = NULL;
+  *out = strtod(text, &end);
+  return *end == '\0' && isfinite(*out);
+}
+
+static int
+parse_name(const char* text, const char* const* names, size_t count, int* out)
+{
+  for (size_t i = 0; text && i < count; ++i)
+    if (strcmp(text, names[i]) == 0) {
+      *out = (int)i;
+      return 1;
+    }
+  return 0;
+}
+
+/* One field's parse by the table's kind: 1 when value fits, into tmp. */
+#define DACPO_SET_SIZE(name)                                                   \
+  (parse_integer(value, 0, SIZE_MAX, &u) && ((tmp.name = (size_t)u), 1))
+#define DACPO_SET_U64(name)                                                    \
+  (parse_integer(value, 0, UINT64_MAX, &u) && ((tmp.name = (uint64_t)u), 1))
+#define DACPO_SET_UINT(name)                                                   \
+  (parse_integer(value, 0, UINT_MAX, &u) && ((tmp.name = (unsigned)u), 1))
+#define DACPO_SET_INT(name)                                                    \
+  (parse_integer(value, INT_MIN, INT_MAX, &u) && ((tmp.name = (int)(long long)u), 1))
+#define DACPO_SET_FLAG(name)                                                   \
+  (parse_integer(value, 0, 1, &u) && ((tmp.name = (int)u), 1))
+#define DACPO_SET_REAL(name) parse_real(value, &tmp.name)
+#define DACPO_SET_ENUM(name)                                                   \
+  (parse_name(value,                                                           \
+              names_##name,                                                    \
+              sizeof(names_##name) / sizeof(names_##name[0]),                  \
+              &e) &&                                                           \
+   ((tmp.name = e), 1))
+
+dacpo_status
+dacpo_params_set(dacpo_params* params,
+                 const char* name,
+                 const char* value,
+                 char* message,
+                 size_t message_size)
+{
+  if (!params || !name || !value)
+    return bad_field(message, message_size, "dacpo_params_set: NULL argument");
+  dacpo_params tmp = *params;
+  unsigned long long u = 0;
+  int e = 0;
+#define DACPO_PARAM(kind, field, def, who, cli, flag, doc)                     \
+  if (strcmp(name, #field) == 0) {                                             \
+    if (!(DACPO_SET_##kind(field)))                                            \
+      return bad_field(message,                                                \
+                       message_size,                                           \
+                       "%s: '%s' is not a value it takes",                     \
+                       name,                                                   \
+                       value);                                                 \
+    *params = tmp;                                                             \
+    return DACPO_OK;                                                           \
+  }
+  DACPO_PARAMS()
+#undef DACPO_PARAM
+  return bad_field(message, message_size, "no parameter is called '%s'", name);
 }
 
 /* The k-NN graph, normals and blocks (stages 0-1). */
@@ -136,11 +236,6 @@ check_dipole_counts(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_restarts must be in [1, 64] (got %zu)",
                      p->dipole_restarts);
-  if (p->dipole_restart_vote != 0 && p->dipole_restart_vote != 1)
-    return bad_field(message,
-                     size,
-                     "dipole_restart_vote must be 0 or 1 (got %d)",
-                     p->dipole_restart_vote);
   return DACPO_OK;
 }
 
@@ -201,11 +296,6 @@ check_dipole_rules(const dacpo_params* p, char* message, size_t size)
                      size,
                      "dipole_two_sheet must be finite (got %g; < 0 = by the scan kind)",
                      p->dipole_two_sheet);
-  if (!(p->normal_weight >= 0.0) || !isfinite(p->normal_weight))
-    return bad_field(message,
-                     size,
-                     "normal_weight must be finite and >= 0 (got %g)",
-                     p->normal_weight);
   if (p->adaptive_normals != 0 && p->adaptive_normals != 1)
     return bad_field(message,
                      size,

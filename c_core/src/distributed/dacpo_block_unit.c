@@ -48,7 +48,6 @@ unit_dipole_params(const dacpo_params* p, size_t b, uint8_t* thin, int8_t* cue)
   dp.layers = p->dipole_layers;
   dp.c_thin = p->dipole_c_thin;
   dp.restarts = p->dipole_restarts;
-  dp.restart_vote = p->dipole_restart_vote;
   dp.sides = p->dipole_sides;
   /* Many views: thin parts show both faces anywhere; 32 neighbours fit the
    * faces of narrow boards (shelves 6 samples deep) better than 24. */

@@ -25,9 +25,7 @@
  * re-decide with all its K neighbours placed, until none changes. The whole
  * run is repeated up to `restarts` times with other orders (voted runs stop
  * after DACPO_DIPOLE_AGREE that all agree); the runs are voted point
- * by point (restart_vote, dipole_vote below), or the one with the highest
- * block energy sum_i s_i sum_t s_j e_ji is kept: one unlucky start no longer
- * decides a block.
+ * by point (dipole_vote below): one unlucky start no longer decides a block.
  *
  * Cost: kd-tree build O(n log n) + n queries of K+1 neighbours, then
  * restarts x (O(M n K) for the orders, O(M^2 n + 2^(M-1) M^2) for the alignment,
@@ -946,16 +944,14 @@ dipole_vote(dipole_work* wk, size_t n, size_t K, size_t R, int sweeps, int8_t* o
 
 /* One restart (paper Eq. 4 greedy + our vote and sweeps): M randomized orders,
  * aligned and majority-voted, then Gauss-Seidel sweeps in order 0's BFS order
- * until no point changes. Writes the signs to cand; returns the block energy
- * sum_i s_i sum_t s_j e_ji (computed only when `score`). */
-static double
+ * until no point changes. Writes the signs to cand. */
+static void
 dipole_restart(dipole_work* wk,
                size_t n,
                size_t K,
                const dacpo_dipole_params* params,
                size_t r,
-               int8_t* cand,
-               int score)
+               int8_t* cand)
 {
   const size_t M = params->orders;
   for (size_t m = 0; m < M; ++m) {
@@ -972,16 +968,6 @@ dipole_restart(dipole_work* wk,
     cand[i] = votes > 0 ? 1 : votes < 0 ? -1 : wk->sign[i];
   }
   dipole_sweeps(wk, n, K, params->final_sweep, cand);
-  if (!score)
-    return 0.0;
-  double energy = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    /* pairs are counted from both ends, the cue once: 2 x unary */
-    const double u = wk->unary ? 2.0 * wk->unary[i] : 0.0;
-    energy += (double)cand[i] *
-              (dipole_field_sum(wk->nb + i * K, wk->w + i * K, K, cand) + u);
-  }
-  return energy;
 }
 
 /* The arguments dacpo_dipole_orient_confidence accepts (n >= 1). */
@@ -1092,29 +1078,19 @@ dacpo_dipole_orient_confidence(const double* xyz,
   }
 
   /* Restarts (each: M orders, aligned, voted, then swept) are voted point by
-   * point (dipole_vote), or scored by the block's own energy sum_i sum_t s_i
-   * s_j e_ij (Eq. 4 summed over all pairs) and the highest kept: either way
-   * one unlucky start no longer decides the block. */
+   * point (dipole_vote): one unlucky start no longer decides the block. */
   size_t R = params->restarts ? params->restarts : 1;
-  const int score = R > 1 && !params->restart_vote;
-  double best_energy = -HUGE_VAL;
-  size_t best = 0;
   for (size_t r = 0; r < R; ++r) {
-    int8_t* cand = wk.cand + r * n;
-    const double energy = dipole_restart(&wk, n, K, params, r, cand, score);
-    if (score && energy > best_energy) {
-      best_energy = energy;
-      best = r;
-    }
+    dipole_restart(&wk, n, K, params, r, wk.cand + r * n);
     /* the first DACPO_DIPOLE_AGREE runs gave one answer (up to the block's
        sign): the vote of more could not change it where they agree too */
-    if (!score && r + 1 == DACPO_DIPOLE_AGREE && R > r + 1 && restarts_agree(wk.cand, n, r + 1))
+    if (r + 1 == DACPO_DIPOLE_AGREE && R > r + 1 && restarts_agree(wk.cand, n, r + 1))
       R = r + 1;
   }
-  if (R > 1 && params->restart_vote)
+  if (R > 1)
     dipole_vote(&wk, n, K, R, params->final_sweep, sign_out);
   else
-    memcpy(sign_out, wk.cand + best * n, n);
+    memcpy(sign_out, wk.cand, n);
   cue_outputs(&wk, n, params, sign_out);
   if (confidence)
     dipole_confidence(&wk, n, K, R, sign_out, confidence);

@@ -14,8 +14,6 @@ typedef struct dacpo_dipole_params {
   int final_sweep;  /* re-decision sweeps with all neighbours placed (until
                        none changes, at most this many; 0 = none) */
   size_t restarts;  /* independent runs of the M orders (0 or 1 = one run) */
-  int restart_vote; /* 1: the restarts are voted point by point; 0: the one
-                       with the highest block energy is kept */
   uint64_t seed;
   uint64_t stream;   /* e.g. the block id: independent of thread count */
   double two_sheet;  /* 0 = off; else pairs on two sheets of one thin part

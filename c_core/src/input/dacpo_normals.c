@@ -2,18 +2,11 @@
 /* Stage 0, normals: PCA normal axes when the caller gives none (paper §4.2
  * starts from unoriented normals "estimated by PCA", Hoppe et al. 1992).
  *
- * For each distinct point p: C = sum w (x - m)(x - m)^T over x in {p} and its
- * first normal_k neighbours, m their weighted mean (centring first keeps
- * precision for clouds far from the origin), w = 1, or with a weight scale
- * (dacpo_params.normal_weight) a Gaussian of the distance to p: the far half of
- * the neighbours, which on a sparse or thin part reaches round a corner or to
- * the other face, counts less, while noise is still averaged over all of them.
- * With dacpo_params.adaptive_normals (the default) each point takes the
- * flattest of 3/4, 1 and 3/2 x normal_k neighbours (pca_point_adaptive).
- * Seeds 1 / 2, 8 rooms and 8 depth frames, mean % wrong: unweighted 6.45 /
- * 6.66 and 4.18 / 3.79; 1.5: 6.13 / 5.70 and 3.88 / 3.63; 1.0: 5.87 / 6.13 and
- * 4.13 / 3.99; 0.7: 5.70 and 4.70 (seed 1). Not the default: over seeds 1-5
- * the frames' worst seed and both suites' seed spread grew (README). The axis is the
+ * For each distinct point p: C = sum (x - m)(x - m)^T over x in {p} and its
+ * first normal_k neighbours, m their mean (centring first keeps precision for
+ * clouds far from the origin). With dacpo_params.adaptive_normals (the
+ * default) each point takes the flattest of 3/4, 1 and 3/2 x normal_k
+ * neighbours (pca_point_adaptive). The axis is the
  * eigenvector of C's smallest eigenvalue l0; the surface variation l0 / (l0 + l1 + l2)
  * (Pauly et al. 2002) is the curvature reported to PCL users. Eigen-solver: cyclic
  * Jacobi on the 3x3 matrix scaled to max |c_ij| = 1. It always returns an orthonormal
@@ -136,7 +129,6 @@ static void
 pca_point(const dacpo_cloud* cloud,
           const dacpo_knn_graph* g,
           size_t normal_k,
-          double weight,
           size_t i,
           double nrm[3],
           double* curv,
@@ -144,30 +136,22 @@ pca_point(const dacpo_cloud* cloud,
 {
   const double* xyz = cloud->xyz;
   const int32_t* row = g->idx + i * g->k;
-  const float* sqd = g->sqd + i * g->k;
-  /* Gaussian weights exp(-d^2 / h^2), h = weight x the distance of the
-   * middle neighbour (all 1 when weight is 0 or that neighbour is missing) */
-  double h2 = normal_k > 1 ? weight * weight * (double)sqd[normal_k / 2] : 0.0;
-  if (!(h2 > 0.0) || !isfinite(h2))
-    h2 = 0.0;
   double m[3] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-  double wsum = 1.0;
+  double count = 1.0;
   for (size_t j = 0; j < normal_k; ++j) {
     int32_t v = row[j];
     if (v < 0 || (size_t)v >= cloud->n)
       continue;
-    const double wt = h2 > 0.0 ? exp(-(double)sqd[j] / h2) : 1.0;
     for (int d = 0; d < 3; ++d)
-      m[d] += wt * xyz[3 * (size_t)v + d];
-    wsum += wt;
+      m[d] += xyz[3 * (size_t)v + d];
+    count += 1.0;
   }
   for (int d = 0; d < 3; ++d)
-    m[d] /= wsum;
+    m[d] /= count;
 
   double c[3][3] = {{0.0}};
   for (size_t j = 0; j <= normal_k; ++j) {
     size_t p;
-    double wt = 1.0;
     if (j == 0) {
       p = i;
     }
@@ -176,12 +160,11 @@ pca_point(const dacpo_cloud* cloud,
       if (v < 0 || (size_t)v >= cloud->n)
         continue;
       p = (size_t)v;
-      wt = h2 > 0.0 ? exp(-(double)sqd[j - 1] / h2) : 1.0;
     }
     double e[3] = {xyz[3 * p] - m[0], xyz[3 * p + 1] - m[1], xyz[3 * p + 2] - m[2]};
     for (int r = 0; r < 3; ++r)
       for (int s = r; s < 3; ++s)
-        c[r][s] += wt * e[r] * e[s];
+        c[r][s] += e[r] * e[s];
   }
   c[1][0] = c[0][1];
   c[2][0] = c[0][2];
@@ -204,7 +187,6 @@ static void
 pca_point_adaptive(const dacpo_cloud* cloud,
                    const dacpo_knn_graph* g,
                    size_t normal_k,
-                   double weight,
                    size_t i,
                    double nrm[3],
                    double* curv)
@@ -215,12 +197,12 @@ pca_point_adaptive(const dacpo_cloud* cloud,
   if (hi_k > g->k)
     hi_k = g->k;
   const size_t scale[3] = {lo_k, normal_k, hi_k};
-  pca_point(cloud, g, normal_k, weight, i, nrm, curv, NULL);
+  pca_point(cloud, g, normal_k, i, nrm, curv, NULL);
   for (int s = 0; s < 3; ++s) {
     if (scale[s] == normal_k)
       continue;
     double a[3], c, elong;
-    pca_point(cloud, g, scale[s], weight, i, a, &c, &elong);
+    pca_point(cloud, g, scale[s], i, a, &c, &elong);
     if (elong >= ADAPTIVE_MIN_SPREAD && c < *curv) {
       memcpy(nrm, a, sizeof(a));
       *curv = c;
@@ -232,7 +214,6 @@ typedef struct normals_job {
   const dacpo_cloud* cloud;
   const dacpo_knn_graph* g;
   size_t normal_k;
-  double weight;
   int adaptive;
   double* nrm;
   float* curvature;
@@ -250,17 +231,9 @@ normals_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
   for (size_t i = begin; i < end; ++i) {
     double curv;
     if (job->adaptive)
-      pca_point_adaptive(
-          job->cloud, job->g, job->normal_k, job->weight, i, job->nrm + 3 * i, &curv);
+      pca_point_adaptive(job->cloud, job->g, job->normal_k, i, job->nrm + 3 * i, &curv);
     else
-      pca_point(job->cloud,
-                job->g,
-                job->normal_k,
-                job->weight,
-                i,
-                job->nrm + 3 * i,
-                &curv,
-                NULL);
+      pca_point(job->cloud, job->g, job->normal_k, i, job->nrm + 3 * i, &curv, NULL);
     if (job->curvature)
       job->curvature[i] = (float)curv;
   }
@@ -276,22 +249,7 @@ dacpo_normals_pca(const dacpo_cloud* cloud,
                   float* curvature,
                   dacpo_err* err)
 {
-  return dacpo_normals_pca_scaled(
-      cloud, g, normal_k, 0.0, 0, num_threads, nrm_out, curvature, err);
-}
-
-dacpo_status
-dacpo_normals_pca_weighted(const dacpo_cloud* cloud,
-                           const dacpo_knn_graph* g,
-                           size_t normal_k,
-                           double weight,
-                           unsigned num_threads,
-                           double* nrm_out,
-                           float* curvature,
-                           dacpo_err* err)
-{
-  return dacpo_normals_pca_scaled(
-      cloud, g, normal_k, weight, 0, num_threads, nrm_out, curvature, err);
+  return dacpo_normals_pca_scaled(cloud, g, normal_k, 0, num_threads, nrm_out, curvature, err);
 }
 
 size_t
@@ -304,7 +262,6 @@ dacpo_status
 dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
                          const dacpo_knn_graph* g,
                          size_t normal_k,
-                         double weight,
                          int adaptive,
                          unsigned num_threads,
                          double* nrm_out,
@@ -333,7 +290,7 @@ dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
               nrm_out != NULL && cloud->xyz != NULL && (g->k == 0 || g->idx != NULL),
               DACPO_ERR_INVALID_ARGUMENT,
               "normals: NULL array");
-  normals_job job = {cloud, g, normal_k, weight, adaptive != 0, nrm_out, curvature};
+  normals_job job = {cloud, g, normal_k, adaptive != 0, nrm_out, curvature};
   size_t tasks = (cloud->n + NORMALS_CHUNK - 1) / NORMALS_CHUNK;
   return dacpo_parallel_for(
       tasks, num_threads, normals_task, &job, NULL, DACPO_STAGE_NORMALS, err);

@@ -19,29 +19,14 @@ dacpo_normals_pca(const dacpo_cloud* cloud,
                   float* curvature,
                   dacpo_err* err);
 
-/* The same with neighbour j weighing exp(-d_j^2 / h^2) in the mean and the
- * covariance, h = weight x the distance of the (normal_k/2 + 1)-th neighbour
- * (dacpo_params.normal_weight); weight 0 is dacpo_normals_pca(). */
-dacpo_status
-dacpo_normals_pca_weighted(const dacpo_cloud* cloud,
-                           const dacpo_knn_graph* g,
-                           size_t normal_k,
-                           double weight,
-                           unsigned num_threads,
-                           double* nrm_out,
-                           float* curvature,
-                           dacpo_err* err);
-
 /* The same, with adaptive != 0 choosing per point among 3/4, 1 and 3/2 x
  * normal_k neighbours the scale whose neighbourhood is flattest
  * (dacpo_params.adaptive_normals); g needs dacpo_normals_width() columns for
- * the largest scale, fewer clamp it. adaptive 0 is
- * dacpo_normals_pca_weighted(). */
+ * the largest scale, fewer clamp it. adaptive 0 is dacpo_normals_pca(). */
 dacpo_status
 dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
                          const dacpo_knn_graph* g,
                          size_t normal_k,
-                         double weight,
                          int adaptive,
                          unsigned num_threads,
                          double* nrm_out,

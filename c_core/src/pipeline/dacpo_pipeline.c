@@ -175,7 +175,6 @@ estimate_normals(run_state* s, dacpo_err* err)
   return dacpo_normals_pca_scaled(&s->cloud,
                                   &s->knn,
                                   nk,
-                                  s->p.normal_weight,
                                   s->p.adaptive_normals,
                                   s->p.num_threads,
                                   s->cloud.nrm,

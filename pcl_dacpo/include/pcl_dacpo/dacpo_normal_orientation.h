@@ -204,21 +204,6 @@ public:
     return params_.normal_k;
   }
 
-  /** \brief Estimated normals: neighbours weigh exp(-d^2 / h^2) in the PCA, h =
-   *  weight x the distance of the middle one; 0 = unweighted (default). 1.5
-   *  helps rooms with thin furniture (README); see dacpo_params.normal_weight. */
-  void
-  setNormalWeight(double weight)
-  {
-    params_.normal_weight = weight;
-  }
-  /** \brief See setNormalWeight(). */
-  double
-  getNormalWeight() const
-  {
-    return params_.normal_weight;
-  }
-
   /** \brief Estimated normals: per point the flattest of 3/4, 1 and 3/2 x
    *  normal_k neighbours (lowest surface variation, no strips); see
    *  dacpo_params.adaptive_normals. */
@@ -401,8 +386,8 @@ public:
     return params_.num_threads;
   }
 
-  /** \brief Independent runs of the dipole stage per block (default 16); see
-   *  setDipoleRestartVote() for how they are combined. */
+  /** \brief Independent runs of the dipole stage per block (default 16),
+   *  voted point by point; they stop once the first four agree. */
   void
   setDipoleRestarts(std::size_t restarts)
   {
@@ -413,21 +398,6 @@ public:
   getDipoleRestarts() const
   {
     return params_.dipole_restarts;
-  }
-
-  /** \brief true (default): the restarts are voted point by point, each
-   *  flipped as a whole to agree with the vote; false: the restart with the
-   *  highest block energy (Eq. 4 over all pairs) is kept. */
-  void
-  setDipoleRestartVote(bool vote)
-  {
-    params_.dipole_restart_vote = vote ? 1 : 0;
-  }
-  /** \brief See setDipoleRestartVote(). */
-  bool
-  getDipoleRestartVote() const
-  {
-    return params_.dipole_restart_vote != 0;
   }
 
   /** \brief Block-graph edges with less than this fraction of the median
@@ -725,6 +695,28 @@ public:
     params_ = params;
     this->k_ = static_cast<int>(params.k);
   }
+  /**
+   * \brief Set one core parameter by its dacpo_params name from text, as the
+   * command line does: setParameter("dipole_c", "2"), setParameter("scan_kind",
+   * "single") (dacpo_params_set(): every row of dacpo_param_table.h). "k" sets
+   * the k-NN size as setKSearch() does.
+   * \return false, with the reason in \a error when given, for an unknown name
+   * or a value the field cannot hold (nothing changes then).
+   */
+  bool
+  setParameter(const std::string& name, const std::string& value, std::string* error = nullptr)
+  {
+    dacpo_params p = getParameters();
+    char msg[256] = "";
+    if (dacpo_params_set(&p, name.c_str(), value.c_str(), msg, sizeof(msg)) != DACPO_OK) {
+      if (error)
+        *error = msg;
+      return false;
+    }
+    setParameters(p);
+    return true;
+  }
+
   /** \brief The parameters the next compute() passes to the core (k from getKSearch()).
    */
   dacpo_params
