@@ -1,0 +1,315 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Shared by the pcl_dacpo_* tools: the command line. An option table
+ * (OptionSpec) gives -h, the parser and the unknown-option check with typo
+ * hints; strict number parsing. Header-only, tools only (not installed). */
+#pragma once
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace dacpo_tool {
+
+/** Lower-case extension including the dot (".pcd"), or "". */
+inline std::string
+extension(const std::string& path)
+{
+  const std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || path.find('/', dot) != std::string::npos)
+    return "";
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
+  return ext;
+}
+
+/** Positional .pcd/.ply arguments in command-line order; values of the options
+ *  named in \a value_options (e.g. "-colored out.pcd") are not positional. */
+inline std::vector<std::string>
+fileArguments(int argc, char** argv, const std::vector<const char*>& value_options = {})
+{
+  std::vector<std::string> files;
+  for (int i = 1; i < argc; ++i) {
+    const std::string ext = extension(argv[i]);
+    if (ext != ".pcd" && ext != ".ply")
+      continue;
+    if (i > 1 &&
+        std::any_of(value_options.begin(), value_options.end(), [&](const char* o) {
+          return std::strcmp(argv[i - 1], o) == 0;
+        }))
+      continue;
+    files.emplace_back(argv[i]);
+  }
+  return files;
+}
+
+/** Edit distance (insert, delete, substitute) of two short strings. */
+inline std::size_t
+editDistance(const std::string& a, const std::string& b)
+{
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min(
+          {row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1u : 0u)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/** Every argument must be a known switch, a known option followed by its
+ *  value, or a .pcd/.ply file: a typo ("-frobnicate 3", "--k 5") must not run
+ *  silently with defaults. On failure returns false with a message naming the
+ *  argument and, when one is close, the option meant. */
+inline bool
+checkArguments(int argc,
+               char** argv,
+               const std::vector<const char*>& switches,
+               const std::vector<const char*>& valued,
+               std::string& error)
+{
+  auto in = [](const std::vector<const char*>& list, const std::string& a) {
+    return std::any_of(list.begin(), list.end(), [&](const char* o) { return a == o; });
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (in(valued, a)) {
+      ++i; /* its value (a missing one is the option parser's to report) */
+      continue;
+    }
+    if (in(switches, a))
+      continue;
+    if (!a.empty() && a[0] == '-') {
+      std::string best;
+      std::size_t best_d = 3; /* suggest only close names */
+      const std::size_t first = a.find_first_not_of('-');
+      const std::string bare =
+          first == std::string::npos ? std::string() : a.substr(first);
+      for (const std::vector<const char*>* list : {&switches, &valued})
+        for (const char* o : *list) {
+          const std::size_t d =
+              std::min(editDistance(a, o), editDistance("-" + bare, o));
+          if (d < best_d) {
+            best_d = d;
+            best = o;
+          }
+        }
+      error = "unknown option '" + a + "'" +
+              (best.empty() ? std::string() : "; did you mean '" + best + "'?") +
+              " (-h lists the options)";
+      return false;
+    }
+    const std::string ext = extension(a);
+    if (ext != ".pcd" && ext != ".ply") {
+      error = "unexpected argument '" + a + "': files must be .pcd or .ply";
+      return false;
+    }
+  }
+  return true;
+}
+
+/** The class of a pointer to member (Options for std::string Options::*). */
+template <typename Member>
+struct MemberOf;
+template <typename Class, typename T>
+struct MemberOf<T Class::*> {
+  using type = Class;
+};
+
+/** Setter of an OptionSpec for an option whose value is kept as given (the tool
+ *  checks it afterwards): setText<&Options::field>. */
+template <auto Field>
+bool
+setText(typename MemberOf<decltype(Field)>::type& o, const std::string& s, std::string&)
+{
+  o.*Field = s;
+  return true;
+}
+
+/** Setter of an OptionSpec for a switch: setFlag<&Options::field>. */
+template <auto Field>
+bool
+setFlag(typename MemberOf<decltype(Field)>::type& o, const std::string&, std::string&)
+{
+  o.*Field = true;
+  return true;
+}
+
+/** One command-line option of a tool's table. The help text (printOptionTable),
+ *  the parser (applyOptions) and the unknown-option check (checkOptionTable) all
+ *  read the tool's table, so an option is named once. */
+template <typename Options, typename Defaults>
+struct OptionSpec {
+  const char* name;
+  const char* arg;  /* nullptr: a switch; else the value's placeholder in -h */
+  const char* help; /* '\n' starts a continuation line */
+  /* the default shown in -h; nullptr: none */
+  std::string (*shown)(const Defaults&);
+  /* sets the options from the value (a switch gets ""); false + error */
+  bool (*apply)(Options&, const std::string&, std::string&);
+};
+
+/** The table entry named \a name, or nullptr. */
+template <typename Spec, std::size_t N>
+const Spec*
+findOption(const Spec (&table)[N], const char* name)
+{
+  for (const Spec& spec : table)
+    if (std::strcmp(spec.name, name) == 0)
+      return &spec;
+  return nullptr;
+}
+
+/** The switches (\a with_value false) or the options that take a value, for
+ *  checkArguments and fileArguments. */
+template <typename Spec, std::size_t N>
+std::vector<const char*>
+optionNames(const Spec (&table)[N], bool with_value)
+{
+  std::vector<const char*> names;
+  for (const Spec& spec : table)
+    if ((spec.arg != nullptr) == with_value)
+      names.push_back(spec.name);
+  return names;
+}
+
+/** checkArguments with the switches and valued options of \a table. */
+template <typename Spec, std::size_t N>
+bool
+checkOptionTable(const Spec (&table)[N], int argc, char** argv, std::string& error)
+{
+  return checkArguments(
+      argc, argv, optionNames(table, false), optionNames(table, true), error);
+}
+
+/** Applies the options in command-line order: a repeated option keeps its last
+ *  value; a missing value or a setter's refusal is printed, then false. */
+template <typename Spec, std::size_t N, typename Options>
+bool
+applyOptions(const Spec (&table)[N], int argc, char** argv, Options& o)
+{
+  for (int i = 1; i < argc; ++i) {
+    const Spec* spec = findOption(table, argv[i]);
+    if (spec == nullptr)
+      continue; /* a file (unknown options were rejected before) */
+    std::string value, error;
+    if (spec->arg != nullptr) {
+      if (i + 1 >= argc || argv[i + 1][0] == '\0') {
+        const bool file = std::strncmp(spec->arg, "F.", 2) == 0;
+        pcl::console::print_error("Error: %s needs a %s (%s)\n",
+                                  spec->name,
+                                  file ? "file name" : "value",
+                                  spec->arg);
+        return false;
+      }
+      value = argv[++i];
+    }
+    if (!spec->apply(o, value, error)) {
+      pcl::console::print_error("Error: %s %s\n", spec->name, error.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+/** Help lines wrap at this many characters (the parameter table's one-line
+ *  docs; hand-written helps break their own lines with '\n'). */
+constexpr std::size_t kHelpWidth = 56;
+
+/** \a text with every line longer than \a width broken at its last space
+ *  before that width. */
+inline std::string
+wrapHelp(const std::string& text, std::size_t width)
+{
+  std::string out;
+  std::size_t line_start = 0;
+  for (char c : text) {
+    out += c;
+    if (c == '\n') {
+      line_start = out.size();
+      continue;
+    }
+    if (out.size() - line_start > width) {
+      const std::size_t space = out.rfind(' ');
+      if (space != std::string::npos && space > line_start) {
+        out[space] = '\n';
+        line_start = space + 1;
+      }
+    }
+  }
+  return out;
+}
+
+/** The options part of -h, one entry per option: 21 spaces, the name and the
+ *  value's placeholder padded to \a head_width, " = ", the help with its
+ *  continuation lines indented by \a indent, and the default if shown. */
+template <typename Spec, std::size_t N, typename Defaults>
+void
+printOptionTable(const Spec (&table)[N],
+                 const Defaults& defaults,
+                 std::size_t head_width,
+                 std::size_t indent)
+{
+  for (const Spec& spec : table) {
+    std::string head = spec.name;
+    if (spec.arg)
+      head += std::string(" ") + spec.arg;
+    if (head.size() < head_width)
+      head.resize(head_width, ' ');
+    std::string text = wrapHelp(spec.help, kHelpWidth);
+    for (std::size_t at = text.find('\n'); at != std::string::npos;
+         at = text.find('\n', at + 1))
+      text.insert(at + 1, indent, ' ');
+    pcl::console::print_info(
+        "                     %s = %s", head.c_str(), text.c_str());
+    if (spec.shown) {
+      pcl::console::print_info(" (default: ");
+      pcl::console::print_value("%s", spec.shown(defaults).c_str());
+      pcl::console::print_info(")");
+    }
+    pcl::console::print_info("\n");
+  }
+}
+
+/** Strict parse of a non-negative integer (no sign, no trailing junk). */
+inline bool
+toUnsigned(const std::string& s, std::uint64_t& v)
+{
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long r = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || *end || errno || s[0] == '-')
+    return false;
+  v = r;
+  return true;
+}
+
+/** Strict parse of a finite number. */
+inline bool
+toDouble(const std::string& s, double& v)
+{
+  char* end = nullptr;
+  errno = 0;
+  const double r = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end || errno || !std::isfinite(r))
+    return false;
+  v = r;
+  return true;
+}
+
+} // namespace dacpo_tool
