@@ -9,6 +9,7 @@
 // test's output; two sheets alone 0 (nothing lies beside them).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -228,4 +229,84 @@ TEST(DacpoLayered, DISABLED_TwoCopiesOfAPlaneKeepOneOrientation)
       printf("plane copies gap %.1f tilt %.1f: %.2f %% wrong\n", gap, tilt, wrong);
       EXPECT_LE(wrong, 2.0) << "gap " << gap << " tilt " << tilt;
     }
+}
+
+namespace {
+
+// % wrong over the points of thin two-sided parts (a point with a ground-truth
+// normal facing the other way within `reach` of it: the two faces of a board),
+// and their count.
+double
+thinPartScore(const dacpo_scene& sc, const std::vector<float>& nrm, double reach, size_t* count)
+{
+  std::vector<double> xyz(sc.xyz, sc.xyz + 3 * sc.n);
+  dacpo_err err{};
+  dacpo_kdtree* tree = nullptr;
+  EXPECT_EQ(dacpo_kdtree_build(xyz.data(), sc.n, &tree, &err), DACPO_OK);
+  const size_t k = 32;
+  int32_t idx[k];
+  double d2[k];
+  size_t thin = 0, wrong = 0;
+  for (size_t i = 0; i < sc.n; ++i) {
+    const float* g = sc.normals + 3 * i;
+    const size_t got = dacpo_kdtree_knn(tree, xyz.data() + 3 * i, k, idx, d2);
+    bool two_faces = false;
+    for (size_t j = 0; j < got && !two_faces; ++j) {
+      const float* h = sc.normals + 3 * (size_t)idx[j];
+      two_faces = d2[j] <= reach * reach && g[0] * h[0] + g[1] * h[1] + g[2] * h[2] < -0.5f;
+    }
+    if (!two_faces)
+      continue;
+    ++thin;
+    wrong += g[0] * nrm[3 * i] + g[1] * nrm[3 * i + 1] + g[2] * nrm[3 * i + 2] < 0.0f;
+  }
+  dacpo_kdtree_free(tree);
+  *count = thin;
+  return thin ? 100.0 * (double)wrong / (double)thin : 0.0;
+}
+
+} // namespace
+
+// Known failure (issue: copies or thin solids). The copies' switch is per
+// scene: where the floor shows copies, the two-sheet rule and the side cue go
+// for the whole scan, thin solids included. A thin board's two faces inside a
+// fused room should still come out facing away from each other (scored as
+// returned: faces of a board facing the same way are half wrong whichever
+// way). Measured (scene seed 2, 3 views 8 mm / 0.2 degrees apart, run seed 1):
+// 7,241 thin-part points; AUTO (copies 0.069: rules off) 48.56 % of them wrong,
+// 7.14 % of the whole room; MULTI_VIEW (rules on) 26.31 % of them, 30.83 % of
+// the room (the copies turned over). Enable when a per-region signal tells the
+// board from the copies.
+TEST(DacpoLayered, DISABLED_ThinPartsInAFusedRoomKeepTheirFacesApart)
+{
+  GeneratedScene fused(roomParams(100000, 3, 2));
+  ASSERT_TRUE(fused.ok);
+  for (dacpo_scan_kind kind : {DACPO_SCAN_AUTO, DACPO_SCAN_MULTI_VIEW}) {
+    std::vector<float> nrm(3 * fused.s.n, 0.0f);
+    dacpo_params p;
+    dacpo_params_init(&p);
+    p.estimate_normals = 1;
+    p.seed = 1;
+    p.scan_kind = kind;
+    dacpo_ctx* ctx = nullptr;
+    ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+    ASSERT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, fused.s.xyz, nrm.data(), fused.s.n),
+              DACPO_OK)
+        << dacpo_ctx_last_error(ctx);
+    const dacpo_stats st = *dacpo_ctx_stats(ctx);
+    dacpo_ctx_free(ctx);
+    size_t thin = 0;
+    const double wrong = thinPartScore(fused.s, nrm, 0.03, &thin);
+    const double all = dacpo_score_oriented(fused.s.normals, nrm.data(), fused.s.n, nullptr, nullptr);
+    printf("fused room (%s): %zu thin-part points, %.2f %% of them wrong, %.2f %% of all "
+           "(copies %.3f, two_sheet %g)\n",
+           kind == DACPO_SCAN_AUTO ? "auto" : "multi",
+           thin,
+           wrong,
+           all,
+           st.layered_copies,
+           st.dipole_two_sheet_used);
+    ASSERT_GT(thin, 1000u);
+    EXPECT_LE(std::min(wrong, 100.0 - wrong), 10.0);
+  }
 }
