@@ -247,7 +247,7 @@ def render(opt):
         if r.returncode != 0:
             log(r.stdout[-1000:] + r.stderr[-2000:])
             sys.exit("report: bench/render.sh failed (scripts/install_bench_deps.sh installs its tools)")
-        lines.append(r.stdout.strip().splitlines()[-1])
+        lines.append(r.stdout.strip().splitlines()[-1].replace(ROOT + os.sep, ""))
     return lines
 
 
@@ -272,7 +272,6 @@ def fmt(v, spec=".2f"):
 def markdown(opt, acc, sc, pngs, pictures, command, stamp):
     names = dict((k, l) for k, l, _ in METHODS)
     seeds = len([s for s in opt.seeds.split(",") if s])
-    command = re.sub(r"(--suite [\w.-]+)=\S+", r"\1=DIR", command)
     L = [f"Measured {stamp}; `{command}`.", "",
          f"**Error per suite** (% of normals wrong after one global sign flip, the paper's metric; "
          f"per file the median over seeds {opt.seeds} for pcl_dacpo, one run for the deterministic peers; "
@@ -335,8 +334,13 @@ def markdown(opt, acc, sc, pngs, pictures, command, stamp):
     L.append("")
     for p in pngs:
         L.append(f"![{p[:-4].replace('_', ' ')}](bench/results/{p})")
-    for line in pictures:
-        L.append(f"`{line}`")
+    L.append("")
+    for line in pictures:  # "render: wrote PATH (caption)"
+        m = re.match(r"render: wrote (\S+) \((.*)\)$", line)
+        if m:
+            name = os.path.basename(m.group(1))
+            L += [f"![{m.group(2)}](bench/results/{name})", "",
+                  f"`bench/render.sh`: {m.group(2)} (generated room, 100K points, scene and run seed 1).", ""]
     L.append("")
     return "\n".join(L)
 
@@ -354,7 +358,8 @@ def into_readme(text):
 
 def main():
     opt = parse()
-    command = "bench/report.sh " + " ".join(sys.argv[1:])
+    # the suites' folders are this machine's: shown as DIR
+    command = re.sub(r"(--suite [\w.-]+)=\S+", r"\1=DIR", "bench/report.sh " + " ".join(sys.argv[1:]))
     os.makedirs(opt.work, exist_ok=True)
     os.makedirs(opt.results, exist_ok=True)
     if opt.rewrite:
@@ -362,11 +367,11 @@ def main():
         acc, sc, pictures = saved["accuracy"], saved["scaling"], saved["pictures"]
         command, opt.seeds, stamp = saved["command"], saved["seeds"], saved["machine"]
     else:
+        stamp = machine()  # the code measured: the commit at the start
         found = tools_and_peers(opt)
         acc = accuracy(opt, found, suites(opt))
         sc = scaling(opt, found)
         pictures = [] if opt.no_render else render(opt)
-        stamp = machine()
     pngs = plots(opt, acc, sc)
     text = markdown(opt, acc, sc, pngs, pictures, command.strip(), stamp)
     with open(os.path.join(opt.results, "report.md"), "w") as fh:
