@@ -162,6 +162,8 @@ struct OptionSpec {
   std::string (*shown)(const Defaults&);
   /* sets the options from the value (a switch gets ""); false + error */
   bool (*apply)(Options&, const std::string&, std::string&);
+  /* a method switch kept for measurement: listed apart in -h */
+  bool expert = false;
 };
 
 /** The table entry named \a name, or nullptr. */
@@ -255,9 +257,32 @@ wrapHelp(const std::string& text, std::size_t width)
   return out;
 }
 
+/** One entry of -h (see printOptionTable). */
+template <typename Spec, typename Defaults>
+void
+printOption(const Spec& spec, const Defaults& defaults, std::size_t head_width, std::size_t indent)
+{
+  std::string head = spec.name;
+  if (spec.arg)
+    head += std::string(" ") + spec.arg;
+  if (head.size() < head_width)
+    head.resize(head_width, ' ');
+  std::string text = wrapHelp(spec.help, kHelpWidth);
+  for (std::size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at + 1))
+    text.insert(at + 1, indent, ' ');
+  pcl::console::print_info("                     %s = %s", head.c_str(), text.c_str());
+  if (spec.shown) {
+    pcl::console::print_info(" (default: ");
+    pcl::console::print_value("%s", spec.shown(defaults).c_str());
+    pcl::console::print_info(")");
+  }
+  pcl::console::print_info("\n");
+}
+
 /** The options part of -h, one entry per option: 21 spaces, the name and the
  *  value's placeholder padded to \a head_width, " = ", the help with its
- *  continuation lines indented by \a indent, and the default if shown. */
+ *  continuation lines indented by \a indent, and the default if shown; the
+ *  expert options after the others, under their own heading. */
 template <typename Spec, std::size_t N, typename Defaults>
 void
 printOptionTable(const Spec (&table)[N],
@@ -265,26 +290,15 @@ printOptionTable(const Spec (&table)[N],
                  std::size_t head_width,
                  std::size_t indent)
 {
-  for (const Spec& spec : table) {
-    std::string head = spec.name;
-    if (spec.arg)
-      head += std::string(" ") + spec.arg;
-    if (head.size() < head_width)
-      head.resize(head_width, ' ');
-    std::string text = wrapHelp(spec.help, kHelpWidth);
-    for (std::size_t at = text.find('\n'); at != std::string::npos;
-         at = text.find('\n', at + 1))
-      text.insert(at + 1, indent, ' ');
-    pcl::console::print_info(
-        "                     %s = %s", head.c_str(), text.c_str());
-    if (spec.shown) {
-      pcl::console::print_info(" (default: ");
-      pcl::console::print_value("%s", spec.shown(defaults).c_str());
-      pcl::console::print_info(")");
-    }
-    pcl::console::print_info("\n");
+  for (int expert = 0; expert < 2; ++expert) {
+    if (expert)
+      pcl::console::print_info("  method switches (for measurement and ablation):\n");
+    for (const Spec& spec : table)
+      if (spec.expert == (expert != 0))
+        printOption(spec, defaults, head_width, indent);
   }
 }
+
 
 /** Strict parse of a non-negative integer (no sign, no trailing junk). */
 inline bool

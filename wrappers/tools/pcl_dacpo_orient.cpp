@@ -162,18 +162,21 @@ showNumber(const dacpo_params& d)
 #define DACPO_CLI_SET_INT(name) setUnsigned<int, &dacpo_params::name>
 #define DACPO_CLI_SET_FLAG(name) setUnsigned<int, &dacpo_params::name>
 #define DACPO_CLI_SET_REAL(name) setDouble<&dacpo_params::name>
-#define DACPO_CLI_VALUE(kind, name, flag, doc)                                           \
+#define DACPO_CLI_EXPERT_USER false
+#define DACPO_CLI_EXPERT_EXPERT true
+#define DACPO_CLI_VALUE(kind, name, who, flag, doc)                                      \
   {flag,                                                                                 \
    "X",                                                                                  \
    doc,                                                                                  \
    showNumber<decltype(dacpo_params::name), &dacpo_params::name>,                        \
-   DACPO_CLI_SET_##kind(name)},
-#define DACPO_CLI_SPECIAL(kind, name, flag, doc)
-#define DACPO_CLI_NONE(kind, name, flag, doc)
+   DACPO_CLI_SET_##kind(name),                                                           \
+   DACPO_CLI_EXPERT_##who},
+#define DACPO_CLI_SPECIAL(kind, name, who, flag, doc)
+#define DACPO_CLI_NONE(kind, name, who, flag, doc)
 
 const OptionSpec kOptions[] = {
     /* every VALUE row of the parameter table: "flag X" */
-#define DACPO_PARAM(kind, name, def, who, cli, flag, doc) DACPO_CLI_##cli(kind, name, flag, doc)
+#define DACPO_PARAM(kind, name, def, who, cli, flag, doc) DACPO_CLI_##cli(kind, name, who, flag, doc)
     DACPO_PARAMS()
 #undef DACPO_PARAM
     {"-estimate",
@@ -189,7 +192,8 @@ const OptionSpec kOptions[] = {
      [](Options& o, const std::string&, std::string&) {
        o.params.vcr_perspective = 1;
        return true;
-     }},
+     },
+     true},
     {"-vcr_c1c2",
      nullptr,
      "VCR score C1*C2 without the boundary factor C_B",
@@ -197,7 +201,8 @@ const OptionSpec kOptions[] = {
      [](Options& o, const std::string&, std::string&) {
        o.params.vcr_boundary_factor = 0;
        return true;
-     }},
+     },
+     true},
     {"-mesh",
      "F.ply",
      "also write the reconstructed surface (one mesh over\n"
@@ -314,7 +319,8 @@ const OptionSpec kOptions[] = {
      [](Options& o, const std::string&, std::string&) {
        o.params.ipsr_enabled = 0;
        return true;
-     }},
+     },
+     true},
     {"-weights",
      "S",
      "block edge weights: vcr | dipole | overlap",
@@ -324,18 +330,12 @@ const OptionSpec kOptions[] = {
                                                       : "dipole";
      },
      [](Options& o, const std::string& s, std::string& error) {
-       if (s == "dipole")
-         o.params.edge_weight = DACPO_WEIGHT_DIPOLE_BOUNDARY;
-       else if (s == "vcr")
-         o.params.edge_weight = DACPO_WEIGHT_VCR;
-       else if (s == "overlap")
-         o.params.edge_weight = DACPO_WEIGHT_OVERLAP;
-       else {
-         error = "must be vcr, dipole or overlap, got '" + s + "'";
-         return false;
-       }
-       return true;
-     }},
+       if (dacpo_params_set(&o.params, "edge_weight", s.c_str(), nullptr, 0) == DACPO_OK)
+         return true;
+       error = "must be vcr, dipole or overlap, got '" + s + "'";
+       return false;
+     },
+     true},
     {"-labels",
      nullptr,
      "add int32 fields block, component and flip, and the\n"
