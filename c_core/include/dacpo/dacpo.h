@@ -177,7 +177,7 @@ typedef struct dacpo_params {
   dacpo_disconnected_policy disconnected; /**< (VIEWPOINT) */
   int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
                                  wound to agree with them; see dacpo_ctx_mesh() (0) */
-  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (200; the
+  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (128; the
                                  paper: 400 for its 200 blocks) */
   size_t vcr_views;         /**< VCR views: 12 = dodecahedron face centres (paper);
                                  other counts use a Fibonacci sphere, [1, 256] (12) */

@@ -63,7 +63,7 @@
               "disconnected parts: viewpoint (each faces the viewpoint the scene implies), separate (relative sign undefined), bridge (joined along their Euclidean MST), error") \
   DACPO_PARAM(FLAG, keep_mesh, 0, USER, SPECIAL, "-mesh F",\
               "also build one crack-free scene mesh from the final normals") \
-  DACPO_PARAM(SIZE, vcr_image_size, 200, EXPERT, VALUE, "-vcr_size",\
+  DACPO_PARAM(SIZE, vcr_image_size, 128, EXPERT, VALUE, "-vcr_size",\
               "VCR image side in pixels (paper: 400)") \
   DACPO_PARAM(SIZE, vcr_views, 12, EXPERT, VALUE, "-vcr_views",\
               "VCR views around each block pair (12: dodecahedron face centres)") \

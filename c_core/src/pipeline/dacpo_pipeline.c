@@ -439,9 +439,7 @@ auto_blocks(size_t n)
    * beside VCR (seam_dipole), or a noisy board's narrow face, a block of its
    * own with a few pixels of VCR evidence, gets flipped. Seeds 1-5, against
    * 1,250 points (cap 200) with VCR alone: frames 1.60 -> 1.51 % (worst 1.78
-   * -> 1.74), rooms 4.70 -> 4.39 % (worst 5.01 -> 4.99). 400 blocks fit the
-   * time budget with VCR images of 200 px (500K room 28.1-30.9 s wall in
-   * five runs; see docs/DESIGN.md). */
+   * -> 1.74), rooms 4.70 -> 4.39 % (worst 5.01 -> 4.99); see docs/DESIGN.md. */
   size_t b = n / 625;
   if (b < 1)
     b = 1;

@@ -477,7 +477,7 @@ public:
     return static_cast<DisconnectedPolicy>(params_.disconnected);
   }
 
-  /** \brief VCR image side in pixels (default 200; the paper: 400 for 200 blocks). */
+  /** \brief VCR image side in pixels (default 128; the paper: 400 for 200 blocks). */
   void
   setVCRImageSize(std::size_t pixels)
   {
