@@ -104,7 +104,7 @@ def test_unknown_parameter_names_the_nearest():
     with pytest.raises(ValueError, match="cue_anchor"):
         pcl_dacpo.orient(pts, cue_anchor=-1.0)
     assert pcl_dacpo.default_params()["seam_dipole"] == 0.5
-    assert pcl_dacpo.default_params()["vcr_image_size"] == 200
+    assert pcl_dacpo.default_params()["vcr_image_size"] == 128
     assert pcl_dacpo.default_params()["surface_vote"] == 500
     with pytest.raises(ValueError, match="seam_dipole"):
         pcl_dacpo.orient(pts, seam_dipole=-1.0)
