@@ -359,7 +359,8 @@ def into_readme(text):
 def main():
     opt = parse()
     # the suites' folders are this machine's: shown as DIR
-    command = re.sub(r"(--suite [\w.-]+)=\S+", r"\1=DIR", "bench/report.sh " + " ".join(sys.argv[1:]))
+    shown = [a for a in sys.argv[1:] if a not in ("--no-readme", "--rewrite")]
+    command = re.sub(r"(--suite [\w.-]+)=\S+", r"\1=DIR", " ".join(["bench/report.sh"] + shown))
     os.makedirs(opt.work, exist_ok=True)
     os.makedirs(opt.results, exist_ok=True)
     if opt.rewrite:
