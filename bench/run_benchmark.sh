@@ -788,8 +788,9 @@ def main():
                 allres[sec]["meta"]["load_at_end"] = os.getloadavg()[0]
             except OSError:
                 pass
+    allres = portable(allres)  # results.md too: no machine's paths
     with open(rj + ".tmp", "w") as f:
-        json.dump(portable(allres), f, indent=1)
+        json.dump(allres, f, indent=1)
     os.replace(rj + ".tmp", rj)
     md = ["# pcl_dacpo benchmark results\n",
           "Written by `bench/run_benchmark.sh` (see bench/README.md); raw records in results.json.\n"]
