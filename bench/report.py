@@ -314,9 +314,9 @@ def markdown(opt, acc, sc, pngs, pictures, command, stamp):
                      f"{r['in_block']:.2f} / {r['flip']:.2f} | " + " | ".join(peers) + " |")
     L += ["", "</details>", ""]
     keys = [k for k, _, _ in METHODS if any(k in r for r in sc)]
-    limit = getattr(opt, "time_limit", None) or 120.0
+    limit = opt.time_limit
 
-    def cell(m, limit):
+    def cell(m):
         if m.get("skipped"):
             return "not run (slower before)"
         if m["rc"] == 124:
@@ -329,7 +329,7 @@ def markdown(opt, acc, sc, pngs, pictures, command, stamp):
           f"% wrong; {limit:.0f} s at most per run):", "",
           "| points | " + " | ".join(names[k] for k in keys) + " |", "|---:|" + "---:|" * len(keys)]
     for r in sc:
-        cells = [cell(r[k], limit) if k in r else "—" for k in keys]
+        cells = [cell(r[k]) if k in r else "—" for k in keys]
         L.append(f"| {r['points']:,} | " + " | ".join(cells) + " |")
     L.append("")
     for p in pngs:

@@ -174,6 +174,23 @@ typedef struct two_sheet_scale {
  * two-sheet window (dacpo_params.dipole_layers = 2 by default). */
 #define DACPO_ONE_SIDED_MAX_SHEET 0.03
 
+double
+dacpo_two_sheet_noise(const double p[3],
+                      const double a[3],
+                      const double* xyz,
+                      const int32_t* row,
+                      size_t m)
+{
+  double off[DACPO_TWO_SHEET_NEAREST];
+  if (m > DACPO_TWO_SHEET_NEAREST)
+    m = DACPO_TWO_SHEET_NEAREST;
+  size_t got = 0;
+  for (size_t t = 0; t < m; ++t)
+    if (row[t] >= 0)
+      off[got++] = fabs(plane_offset(p, a, xyz + 3 * (size_t)row[t]));
+  return got ? dacpo_select_kth(off, got, got / 4) : 0.0;
+}
+
 static dacpo_status
 two_sheet_scales(const double* xyz,
                  const double* nrm,
@@ -188,17 +205,10 @@ two_sheet_scales(const double* xyz,
   ts->sheet = dacpo_calloc_array(n, sizeof(uint8_t));
   if (!ts->noise || !ts->local || !ts->sheet)
     return DACPO_OOM(err);
-  const size_t m = K < DACPO_TWO_SHEET_NEAREST ? K : DACPO_TWO_SHEET_NEAREST;
-  double off[DACPO_TWO_SHEET_NEAREST];
   double* tmp = wk->w; /* scratch until the energies are written */
   for (size_t i = 0; i < n; ++i) {
     const double* p = xyz + 3 * i;
-    const double* a = nrm + 3 * i;
-    for (size_t t = 0; t < m; ++t) {
-      const double* q = xyz + 3 * (size_t)wk->nb[i * K + t];
-      off[t] = fabs(plane_offset(p, a, q));
-    }
-    ts->noise[i] = dacpo_select_kth(off, m, m / 4);
+    ts->noise[i] = dacpo_two_sheet_noise(p, nrm + 3 * i, xyz, wk->nb + i * K, K);
     double sum = 0.0;
     const size_t near = K < 4 ? K : 4;
     for (size_t t = 0; t < near; ++t) {

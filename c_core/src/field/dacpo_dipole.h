@@ -42,6 +42,18 @@ typedef struct dacpo_dipole_params {
                         where it disagrees, 0 elsewhere */
 } dacpo_dipole_params;
 
+/* The two-sheet test's local noise scale of point p (unit axis a): the 25th
+ * percentile of |offset| from its tangent plane of the first
+ * min(m, DACPO_TWO_SHEET_NEAREST) points of row (indices into xyz; negative
+ * entries skipped); 0 when none. Low enough that a second sheet (up to half
+ * the neighbours) does not count as noise. */
+double
+dacpo_two_sheet_noise(const double p[3],
+                      const double a[3],
+                      const double* xyz,
+                      const int32_t* row,
+                      size_t m);
+
 /* Stage 2's two-sheet pair test: 1 if (p, axis a) and (q, axis b) lie on two
  * sheets of one thin part (or two copies of one surface): axes within ~37
  * degrees, each point off the other's tangent plane by more than

@@ -52,7 +52,6 @@
 #define LAYERED_BAND 3.0 /* band thickness, spacings */
 #define LAYERED_K 32     /* neighbours of the side test (as stage 2 on many views) */
 
-#define LAYERED_NOISE_K 16     /* neighbours of the local noise scale (as stage 2) */
 #define LAYERED_PAIR_NOISE 3.0 /* stage 2's default two-sheet factor */
 #define LAYERED_PAIRS 3
 
@@ -62,25 +61,12 @@ dot3(const double* a, const double* b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static double
-offset(const double* p, const double* a, const double* q)
-{
-  return (q[0] - p[0]) * a[0] + (q[1] - p[1]) * a[1] + (q[2] - p[2]) * a[2];
-}
-
-/* The 25th percentile of |offset| of point i's nearest from its tangent plane. */
+/* Stage 2's local noise scale of point i, from its k nearest. */
 static double
 local_noise(
     const double* xyz, const double* axes, const int32_t* idx, size_t k, size_t i)
 {
-  double off[LAYERED_NOISE_K];
-  const size_t m = k < LAYERED_NOISE_K ? k : LAYERED_NOISE_K;
-  size_t got = 0;
-  for (size_t t = 0; t < m; ++t)
-    if (idx[i * k + t] >= 0)
-      off[got++] =
-          fabs(offset(xyz + 3 * i, axes + 3 * i, xyz + 3 * (size_t)idx[i * k + t]));
-  return got ? dacpo_select_kth(off, got, got / 4) : 0.0;
+  return dacpo_two_sheet_noise(xyz + 3 * i, axes + 3 * i, xyz, idx + i * k, k);
 }
 
 /* Mean distance of point i's 4 nearest. */
