@@ -269,7 +269,26 @@ def fmt(v, spec=".2f"):
     return "—" if v is None else format(v, spec)
 
 
-def markdown(opt, acc, sc, pngs, pictures, command, stamp):
+def per_file_table(acc, names):
+    L = ["<details><summary>Every file</summary>", "",
+          "| suite | file | points | pcl_dacpo median (worst) | in-block / flip | " +
+          " | ".join(names[k] for k, _, p in METHODS if p and any(k in acc[s] for s in acc)) + " |",
+          "|---|---|---:|---:|---:|" + "---:|" * sum(1 for k, _, p in METHODS
+                                                   if p and any(k in acc[s] for s in acc))]
+    for s in acc:
+        for r in acc[s].get("dacpo", []):
+            peers = []
+            for k, _, p in METHODS:
+                if p and any(k in acc[t] for t in acc):
+                    m = next((x for x in acc[s].get(k, []) if x["file"] == r["file"]), None)
+                    peers.append(fmt(m and m["median"]))
+            L.append(f"| {s} | {r['file']} | {r['points']} | {r['median']:.2f} ({r['worst']:.2f}) | "
+                     f"{r['in_block']:.2f} / {r['flip']:.2f} | " + " | ".join(peers) + " |")
+    return L + ["", "</details>", ""]
+
+
+def markdown(opt, acc, sc, pngs, pictures, command, stamp, per_file=True):
+    """The results; per_file=False (the README) links report.md for the table of every file."""
     names = dict((k, l) for k, l, _ in METHODS)
     seeds = len([s for s in opt.seeds.split(",") if s])
     L = [f"Measured {stamp}; `{command}`.", "",
@@ -298,21 +317,10 @@ def markdown(opt, acc, sc, pngs, pictures, command, stamp):
                      f"{sum(r['component'] for r in acc[s]['dacpo']) / len(acc[s]['dacpo']):.2f}"
                      for s in acc if acc[s].get("dacpo")) + ".")
         L.append("")
-    L += ["<details><summary>Every file</summary>", "",
-          "| suite | file | points | pcl_dacpo median (worst) | in-block / flip | " +
-          " | ".join(names[k] for k, _, p in METHODS if p and any(k in acc[s] for s in acc)) + " |",
-          "|---|---|---:|---:|---:|" + "---:|" * sum(1 for k, _, p in METHODS
-                                                   if p and any(k in acc[s] for s in acc))]
-    for s in acc:
-        for r in acc[s].get("dacpo", []):
-            peers = []
-            for k, _, p in METHODS:
-                if p and any(k in acc[t] for t in acc):
-                    m = next((x for x in acc[s].get(k, []) if x["file"] == r["file"]), None)
-                    peers.append(fmt(m and m["median"]))
-            L.append(f"| {s} | {r['file']} | {r['points']} | {r['median']:.2f} ({r['worst']:.2f}) | "
-                     f"{r['in_block']:.2f} / {r['flip']:.2f} | " + " | ".join(peers) + " |")
-    L += ["", "</details>", ""]
+    if per_file:
+        L += per_file_table(acc, names)
+    else:
+        L += ["Every file, every method: [`bench/results/report.md`](bench/results/report.md).", ""]
     keys = [k for k, _, _ in METHODS if any(k in r for r in sc)]
     limit = opt.time_limit
 
@@ -377,6 +385,7 @@ def main():
     text = markdown(opt, acc, sc, pngs, pictures, command.strip(), stamp)
     with open(os.path.join(opt.results, "report.md"), "w") as fh:
         fh.write("# pcl_dacpo results (written by bench/report.sh)\n\n" + text.replace("](bench/results/", "]("))
+    text = markdown(opt, acc, sc, pngs, pictures, command.strip(), stamp, per_file=False)
     with open(os.path.join(opt.results, "report.json"), "w") as fh:
         json.dump(dict(accuracy=acc, scaling=sc, pictures=pictures, machine=stamp, command=command,
                        seeds=opt.seeds), fh, indent=1)

@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The README's parameter tables, written from the one parameter table
+"""The documents' parameter tables, written from the one parameter table
 (c_core/include/dacpo/dacpo_param_table.h): field, command-line option,
-default and contract of every row, the USER rows first.
+default and contract of every row. A block between
+"<!-- scripts/param_table.py: begin USER -->" (or EXPERT) and
+"<!-- scripts/param_table.py: end -->" gets the rows of that audience: the
+README has the USER rows, docs/PARAMETERS.md the method switches.
 
-  scripts/param_table.py              print the tables
-  scripts/param_table.py --write F    replace the block of F between its
-                                      "scripts/param_table.py" markers
-  scripts/param_table.py --check F    exit 1 when that block differs (a test)
+  scripts/param_table.py                 print both tables
+  scripts/param_table.py --write F...    fill every block of each file
+  scripts/param_table.py --check F...    exit 1 when a block differs (a test)
 """
 import os
 import re
@@ -15,8 +17,9 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 HEADER = os.path.join(ROOT, "c_core", "include", "dacpo", "dacpo_param_table.h")
-BEGIN = "<!-- scripts/param_table.py: begin -->"
+BEGIN = re.compile(r"<!-- scripts/param_table.py: begin (USER|EXPERT) -->")
 END = "<!-- scripts/param_table.py: end -->"
+TITLES = {"USER": "Set by users", "EXPERT": "Method switches (for measurement and ablation)"}
 ROW = re.compile(r'DACPO_PARAM\((\w+), (\w+), ([^,]+), (USER|EXPERT), (VALUE|SPECIAL|NONE), '
                  r'"([^"]*)",\s*\\?\s*"([^"]*)"\)')
 
@@ -39,48 +42,52 @@ def default_text(kind, value):
     return value
 
 
-def markdown():
-    out = []
-    for who, title in (("USER", "Set by users"), ("EXPERT", "Method switches (for measurement and ablation)")):
-        out += [f"**{title}**", "", "| field | CLI | default | contract |", "|---|---|---|---|"]
-        for kind, name, value, audience, cli, flag, doc in rows():
-            if audience != who:
-                continue
-            shown = ", ".join(f"`{f.strip()}`" for f in flag.split(",")) if flag else "—"
-            out.append(f"| `{name}` | {shown} | {default_text(kind, value)} | {doc} |")
-        out.append("")
-    return "\n".join(out)
+def markdown(who):
+    out = [f"**{TITLES[who]}**", "", "| field | CLI | default | contract |", "|---|---|---|---|"]
+    for kind, name, value, audience, cli, flag, doc in rows():
+        if audience != who:
+            continue
+        shown = ", ".join(f"`{f.strip()}`" for f in flag.split(",")) if flag else "—"
+        out.append(f"| `{name}` | {shown} | {default_text(kind, value)} | {doc} |")
+    return "\n".join(out) + "\n"
 
 
-def block_of(path):
+def filled(path):
+    """The file's text with every block filled in; exits if it has none."""
     text = open(path, encoding="utf-8").read()
-    if BEGIN not in text or END not in text:
-        sys.exit(f"param_table: {path} has no {BEGIN} ... {END} block")
-    a, b = text.index(BEGIN) + len(BEGIN), text.index(END)
-    return text, a, b
+    out, pos, blocks = [], 0, 0
+    for m in BEGIN.finditer(text):
+        end = text.find(END, m.end())
+        if end < 0:
+            sys.exit(f"param_table: {path}: no {END} after {m.group(0)}")
+        out += [text[pos:m.end()], "\n" + markdown(m.group(1)) + "\n"]
+        pos, blocks = end, blocks + 1
+    if not blocks:
+        sys.exit(f"param_table: {path} has no scripts/param_table.py block")
+    return text, "".join(out) + text[pos:]
 
 
 def main(argv):
-    table = markdown()
     if len(argv) == 1:
-        print(table)
+        print(markdown("USER") + "\n" + markdown("EXPERT"))
         return 0
-    if len(argv) != 3 or argv[1] not in ("--write", "--check"):
+    if len(argv) < 3 or argv[1] not in ("--write", "--check"):
         print(__doc__, file=sys.stderr)
         return 2
-    text, a, b = block_of(argv[2])
-    wanted = "\n" + table + "\n"
-    if argv[1] == "--check":
-        if text[a:b] != wanted:
-            print(f"param_table: the parameter table in {argv[2]} is not the one "
-                  f"dacpo_param_table.h gives; run scripts/param_table.py --write {argv[2]}",
-                  file=sys.stderr)
-            return 1
-        return 0
-    with open(argv[2] + ".tmp", "w", encoding="utf-8") as fh:
-        fh.write(text[:a] + wanted + text[b:])
-    os.replace(argv[2] + ".tmp", argv[2])
-    return 0
+    status = 0
+    for path in argv[2:]:
+        text, wanted = filled(path)
+        if argv[1] == "--check":
+            if text != wanted:
+                print(f"param_table: the parameter table in {path} is not the one "
+                      f"dacpo_param_table.h gives; run scripts/param_table.py --write {path}",
+                      file=sys.stderr)
+                status = 1
+            continue
+        with open(path + ".tmp", "w", encoding="utf-8") as fh:
+            fh.write(wanted)
+        os.replace(path + ".tmp", path)
+    return status
 
 
 if __name__ == "__main__":

@@ -15,7 +15,8 @@
  *     tests/c_core/bench_ipsr.c c_core/src/dacpo_ipsr.c \
  *     c_core/src/dacpo_poisson.c c_core/src/dacpo_mcubes.c \
  *     c_core/src/dacpo_kdtree.c c_core/src/dacpo_context.c \
- *     wrappers/support/dacpo_ply.c -lm -o bench_ipsr
+ *     wrappers/support/dacpo_ply.c wrappers/support/dacpo_ply_write.c \
+ *     -lm -o bench_ipsr
  * Usage:
  *   bench_ipsr [-n points] [-flip share] [-blocks per_scan]
  *              [-cps cell_per_spacing] [-alpha point_weight] [-tol tolerance]

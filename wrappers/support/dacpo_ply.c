@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * Minimal PLY reader and writer for point clouds with normals (dacpo_ply.h).
+ * This file reads; the writer is in dacpo_ply_write.c, and reading a binary
+ * file's vertex rows in parts (dacpo_ply_rows_*) in dacpo_ply_rows.c.
  *
- * Writer: binary little-endian, float x y z [nx ny nz], byte order fixed by
- * explicit shifts so the output is the same on any host.
  * Reader: parses the header (elements, scalar and list properties, the three
  * formats), skips the elements before "vertex", then decodes the vertex rows
  * through a small buffered reader. Before allocating, the declared vertex count
@@ -17,6 +17,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "dacpo_ply.h"
 
+#include "dacpo_ply_internal.h"
 #include "dacpo_support_err.h"
 
 #include <errno.h>
@@ -28,166 +29,9 @@
 
 #define PLY_MAX_LINE 1024
 #define PLY_MAX_HEADER_LINES 4096
-#define PLY_MAX_ELEMENTS 64
-#define PLY_MAX_PROPS 128
-#define PLY_BUF_SIZE 65536
-
-/* ------------------------------------------------------------------------- */
-/* Writer.                                                                    */
-
-static unsigned char*
-put_f32le(unsigned char* p, float f)
-{
-  uint32_t u;
-  memcpy(&u, &f, sizeof(u));
-  p[0] = (unsigned char)(u & 0xffu);
-  p[1] = (unsigned char)((u >> 8) & 0xffu);
-  p[2] = (unsigned char)((u >> 16) & 0xffu);
-  p[3] = (unsigned char)((u >> 24) & 0xffu);
-  return p + 4;
-}
-
-static unsigned char*
-put_f64le(unsigned char* p, double d)
-{
-  uint64_t u;
-  memcpy(&u, &d, sizeof(u));
-  for (int b = 0; b < 8; ++b)
-    p[b] = (unsigned char)((u >> (8 * b)) & 0xffu);
-  return p + 8;
-}
-
-/* Each line of `comment` becomes one "comment" header line. */
-static int
-write_comments(FILE* f, const char* comment)
-{
-  const char* p = comment;
-  if (!comment)
-    return 0;
-  while (*p) {
-    const char* e = strchr(p, '\n');
-    const size_t len = e ? (size_t)(e - p) : strlen(p);
-    if (fprintf(f, "comment %.*s\n", (int)(len > 4000 ? 4000 : len), p) < 0)
-      return -1;
-    p += len;
-    if (*p == '\n')
-      ++p;
-  }
-  return 0;
-}
-
-/* Float (xyz) or double (xyz_d) coordinates, float normals when given. */
-static int
-ply_write(const char* path,
-          const float* xyz,
-          const double* xyz_d,
-          const float* normals,
-          size_t n,
-          const char* comment,
-          char* err,
-          size_t errlen)
-{
-  const size_t per = 3 * (xyz_d ? 2 : 1) + (normals ? 3 : 0);
-  const char* type = xyz_d ? "double" : "float";
-  const size_t chunk = 4096;
-  unsigned char* buf;
-  FILE* f;
-  int bad = 0;
-
-  if (err && errlen > 0)
-    err[0] = '\0';
-  if (!path || (!xyz && !xyz_d && n > 0)) {
-    dacpo_support_err(
-        err, errlen, "dacpo_ply_write: %s is NULL", !path ? "path" : "xyz");
-    return DACPO_PLY_ERR_ARGUMENT;
-  }
-  buf = (unsigned char*)malloc(chunk * per * 4); /* per counts 4-byte words */
-  if (!buf) {
-    dacpo_support_err(err, errlen, "out of memory");
-    return DACPO_PLY_ERR_MEMORY;
-  }
-  f = fopen(path, "wb");
-  if (!f) {
-    dacpo_support_err(
-        err, errlen, "cannot open '%s' for writing: %s", path, strerror(errno));
-    free(buf);
-    return DACPO_PLY_ERR_IO;
-  }
-  if (fprintf(f, "ply\nformat binary_little_endian 1.0\n") < 0 ||
-      write_comments(f, comment) != 0 ||
-      fprintf(f,
-              "element vertex %zu\nproperty %s x\nproperty %s y\nproperty %s z\n",
-              n,
-              type,
-              type,
-              type) < 0 ||
-      (normals && fprintf(f,
-                          "property float nx\nproperty float ny\n"
-                          "property float nz\n") < 0) ||
-      fprintf(f, "end_header\n") < 0)
-    bad = 1;
-  for (size_t i0 = 0; i0 < n && !bad; i0 += chunk) {
-    const size_t m = n - i0 < chunk ? n - i0 : chunk;
-    unsigned char* p = buf;
-    for (size_t i = i0; i < i0 + m; ++i) {
-      for (size_t k = 0; k < 3; ++k)
-        p = xyz_d ? put_f64le(p, xyz_d[3 * i + k]) : put_f32le(p, xyz[3 * i + k]);
-      if (normals)
-        for (size_t k = 0; k < 3; ++k)
-          p = put_f32le(p, normals[3 * i + k]);
-    }
-    if (fwrite(buf, 1, (size_t)(p - buf), f) != (size_t)(p - buf))
-      bad = 1;
-  }
-  free(buf);
-  if (bad) {
-    dacpo_support_err(err, errlen, "write error on '%s': %s", path, strerror(errno));
-    fclose(f);
-    return DACPO_PLY_ERR_IO;
-  }
-  if (fclose(f) != 0) {
-    dacpo_support_err(
-        err, errlen, "write error on '%s' (close): %s", path, strerror(errno));
-    return DACPO_PLY_ERR_IO;
-  }
-  return DACPO_PLY_OK;
-}
-
-int
-dacpo_ply_write(const char* path,
-                const float* xyz,
-                const float* normals,
-                size_t n,
-                const char* comment,
-                char* err,
-                size_t errlen)
-{
-  return ply_write(path, xyz, NULL, normals, n, comment, err, errlen);
-}
-
-int
-dacpo_ply_write_exact(const char* path,
-                      const double* xyz,
-                      const float* normals,
-                      size_t n,
-                      const char* comment,
-                      char* err,
-                      size_t errlen)
-{
-  return ply_write(path, NULL, xyz, normals, n, comment, err, errlen);
-}
 
 /* ------------------------------------------------------------------------- */
 /* Buffered input.                                                            */
-
-typedef struct ply_in {
-  FILE* f;
-  unsigned char* buf;
-  size_t pos, len;
-  size_t consumed; /* bytes handed out so far (header included) */
-  int eof;
-  int eol; /* ASCII: the last token ended its line */
-} ply_in;
 
 static int
 in_fill(ply_in* in)
@@ -313,33 +157,6 @@ in_row_end(ply_in* in)
 /* ------------------------------------------------------------------------- */
 /* Header model.                                                              */
 
-typedef enum ply_type {
-  T_NONE = 0,
-  T_I8,
-  T_U8,
-  T_I16,
-  T_U16,
-  T_I32,
-  T_U32,
-  T_F32,
-  T_F64
-} ply_type;
-
-typedef struct ply_prop {
-  ply_type type;       /* scalar type, or the item type of a list */
-  ply_type count_type; /* T_NONE for scalars */
-  int role;            /* 0..5 = x y z nx ny nz, -1 other */
-} ply_prop;
-
-typedef struct ply_element {
-  char name[64];
-  uint64_t count;
-  ply_prop props[PLY_MAX_PROPS];
-  int nprops;
-} ply_element;
-
-enum { FMT_ASCII, FMT_BLE, FMT_BBE };
-
 static ply_type
 parse_type(const char* s)
 {
@@ -368,8 +185,8 @@ parse_type(const char* s)
   return T_NONE;
 }
 
-static size_t
-type_size(ply_type t)
+size_t
+dacpo_ply_type_size(ply_type t)
 {
   switch (t) {
   case T_I8:
@@ -391,8 +208,8 @@ type_size(ply_type t)
 }
 
 /* 1 when a value of type t converts to float exactly. */
-static int
-exact_in_float(ply_type t)
+int
+dacpo_ply_exact_in_float(ply_type t)
 {
   return t != T_F64 && t != T_I32 && t != T_U32;
 }
@@ -408,11 +225,11 @@ prop_role(const char* name)
 }
 
 /* Decode one binary value of type t at p (swap = file is big-endian). */
-static double
-decode(const unsigned char* p, ply_type t, int swap)
+double
+dacpo_ply_decode(const unsigned char* p, ply_type t, int swap)
 {
   unsigned char b[8];
-  const size_t sz = type_size(t);
+  const size_t sz = dacpo_ply_type_size(t);
   for (size_t i = 0; i < sz; ++i)
     b[i] = swap ? p[sz - 1 - i] : p[i];
   /* From here b holds the little-endian bytes; assemble portably. */
@@ -467,12 +284,6 @@ parse_count(const char* s, uint64_t* out)
   *out = (uint64_t)v;
   return 0;
 }
-
-typedef struct ply_header {
-  int format;
-  ply_element* el; /* PLY_MAX_ELEMENTS */
-  int nel;
-} ply_header;
 
 /* Split s in place at spaces and tabs; at most max words (the rest is ignored,
  * extra words only make a line invalid through the callers' count checks). */
@@ -665,9 +476,9 @@ read_value(ply_in* in, int format, ply_type t, double* v, int first)
   }
   {
     unsigned char b[8];
-    if (in_read(in, b, type_size(t)) != 0)
+    if (in_read(in, b, dacpo_ply_type_size(t)) != 0)
       return -1;
-    *v = decode(b, t, format == FMT_BBE);
+    *v = dacpo_ply_decode(b, t, format == FMT_BBE);
     return 0;
   }
 }
@@ -692,7 +503,7 @@ read_row(ply_in* in, int format, const ply_element* e, double vals[6])
           if ((rc = read_value(in, format, p->type, &v, 0)) != 0)
             return rc;
       }
-      else if (in_skip(in, (uint64_t)cnt * type_size(p->type)) != 0) {
+      else if (in_skip(in, (uint64_t)cnt * dacpo_ply_type_size(p->type)) != 0) {
         return -1;
       }
       continue;
@@ -716,7 +527,7 @@ min_row_bytes(int format, const ply_element* e)
     if (format == FMT_ASCII)
       s += 2; /* a digit and a separator */
     else
-      s += type_size(p->count_type != T_NONE ? p->count_type : p->type);
+      s += dacpo_ply_type_size(p->count_type != T_NONE ? p->count_type : p->type);
   }
   return s;
 }
@@ -833,7 +644,7 @@ vertex_needs_double(const ply_element* vert)
 {
   for (int j = 0; j < vert->nprops; ++j)
     if (vert->props[j].role >= 0 && vert->props[j].role < 3 &&
-        !exact_in_float(vert->props[j].type))
+        !dacpo_ply_exact_in_float(vert->props[j].type))
       return 1;
   return 0;
 }
@@ -917,15 +728,15 @@ open_sized(const char* path, ply_in* in, long* fsize, char* err, size_t errlen)
 /* Opens path and reads up to its first vertex row: the header, the vertex
  * element (*vert, *has_normals), the elements before it, the count check. On
  * success in->f is open at vertex 0 and in->buf, h->el are allocated; on failure
- * as much as was opened, which ply_close() releases either way. */
-static int
-open_vertices(const char* path,
-              ply_in* in,
-              ply_header* h,
-              ply_element** vert,
-              int* has_normals,
-              char* err,
-              size_t errlen)
+ * as much as was opened, which dacpo_ply_close() releases either way. */
+int
+dacpo_ply_open_vertices(const char* path,
+                        ply_in* in,
+                        ply_header* h,
+                        ply_element** vert,
+                        int* has_normals,
+                        char* err,
+                        size_t errlen)
 {
   long fsize = 0;
   memset(in, 0, sizeof(*in));
@@ -952,8 +763,8 @@ open_vertices(const char* path,
   return status;
 }
 
-static void
-ply_close(ply_in* in, ply_header* h)
+void
+dacpo_ply_close(ply_in* in, ply_header* h)
 {
   free(h->el);
   free(in->buf);
@@ -995,7 +806,7 @@ ply_read(const char* path, int exact, dacpo_ply_cloud* out, char* err, size_t er
     return DACPO_PLY_ERR_ARGUMENT;
   }
   memset(&c, 0, sizeof(c));
-  int status = open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
+  int status = dacpo_ply_open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
   if (status == DACPO_PLY_OK)
     status = read_vertices(&in, h.format, vert, has_normals, exact, &c, path, err, errlen);
   if (status == DACPO_PLY_OK && ferror(in.f)) {
@@ -1007,193 +818,8 @@ ply_read(const char* path, int exact, dacpo_ply_cloud* out, char* err, size_t er
     memset(&c, 0, sizeof(c));
   }
   dacpo_ply_cloud_free(&c);
-  ply_close(&in, &h);
+  dacpo_ply_close(&in, &h);
   return status;
-}
-
-int
-dacpo_ply_rows_open(const char* path, dacpo_ply_rows* out, char* err, size_t errlen)
-{
-  ply_in in;
-  ply_header h;
-  ply_element* vert = NULL;
-  int has_normals = 0;
-  if (err && errlen > 0)
-    err[0] = '\0';
-  if (!path || !out) {
-    dacpo_support_err(err, errlen, "dacpo_ply_rows_open: NULL argument");
-    return DACPO_PLY_ERR_ARGUMENT;
-  }
-  memset(out, 0, sizeof(*out));
-  int status = open_vertices(path, &in, &h, &vert, &has_normals, err, errlen);
-  if (status == DACPO_PLY_OK && h.format == FMT_ASCII) {
-    dacpo_support_err(err,
-                      errlen,
-                      "'%s' is ASCII PLY: reading it in parts needs binary PLY "
-                      "(convert it first, e.g. pcl_dacpo_orient writes binary PLY)",
-                      path);
-    status = DACPO_PLY_ERR_FORMAT;
-  }
-  for (int j = 0; status == DACPO_PLY_OK && j < vert->nprops; ++j)
-    if (vert->props[j].count_type != T_NONE) {
-      dacpo_support_err(
-          err, errlen, "'%s': the vertex element has a list property: rows differ in size", path);
-      status = DACPO_PLY_ERR_FORMAT;
-    }
-  if (status == DACPO_PLY_OK) {
-    out->n = vert->count;
-    out->data_offset = in.consumed;
-    out->swap = h.format == FMT_BBE;
-    size_t off = 0;
-    for (int j = 0; j < vert->nprops; ++j) {
-      const ply_prop* pr = &vert->props[j];
-      if (pr->role >= 0 && pr->role < 3) {
-        out->offset[pr->role] = off;
-        out->type[pr->role] = (int)pr->type;
-      }
-      off += type_size(pr->type);
-    }
-    out->stride = off;
-  }
-  ply_close(&in, &h);
-  return status;
-}
-
-/* Calls emit(rows, row, i, user) for the rows [first, first + count) of f. */
-static int
-rows_walk(FILE* f,
-          const dacpo_ply_rows* rows,
-          unsigned long long first,
-          size_t count,
-          void (*emit)(const dacpo_ply_rows*, const unsigned char*, size_t, void*),
-          void* user,
-          char* err,
-          size_t errlen)
-{
-  if (!f || !rows || (!user && count > 0) || first > rows->n || count > rows->n - first) {
-    dacpo_support_err(err, errlen, "dacpo_ply_rows_read: bad argument or range");
-    return DACPO_PLY_ERR_ARGUMENT;
-  }
-  unsigned char buf[PLY_BUF_SIZE];
-  const size_t per = PLY_BUF_SIZE / rows->stride;
-  if (per == 0 || fseeko(f, (off_t)(rows->data_offset + first * rows->stride), SEEK_SET) != 0) {
-    dacpo_support_err(err, errlen, "cannot seek to vertex %llu", first);
-    return DACPO_PLY_ERR_IO;
-  }
-  for (size_t done = 0; done < count;) {
-    const size_t take = count - done < per ? count - done : per;
-    if (fread(buf, rows->stride, take, f) != take) {
-      dacpo_support_err(err, errlen, "short read at vertex %llu", first + done);
-      return DACPO_PLY_ERR_IO;
-    }
-    for (size_t i = 0; i < take; ++i)
-      emit(rows, buf + i * rows->stride, done + i, user);
-    done += take;
-  }
-  return DACPO_PLY_OK;
-}
-
-static void
-emit_float(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
-{
-  float* xyz = (float*)user;
-  for (int k = 0; k < 3; ++k)
-    xyz[3 * i + (size_t)k] =
-        (float)(decode(row + rows->offset[k], (ply_type)rows->type[k], rows->swap) -
-                rows->origin[k]);
-}
-
-static void
-emit_double(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
-{
-  double* xyz = (double*)user;
-  for (int k = 0; k < 3; ++k)
-    xyz[3 * i + (size_t)k] = decode(row + rows->offset[k], (ply_type)rows->type[k], rows->swap);
-}
-
-static void
-emit_raw(const dacpo_ply_rows* rows, const unsigned char* row, size_t i, void* user)
-{
-  unsigned char* out = (unsigned char*)user + i * dacpo_ply_rows_xyz_bytes(rows);
-  for (int k = 0; k < 3; ++k) {
-    const size_t sz = type_size((ply_type)rows->type[k]);
-    for (size_t b = 0; b < sz; ++b) /* little-endian, as the output is */
-      *out++ = row[rows->offset[k] + (rows->swap ? sz - 1 - b : b)];
-  }
-}
-
-int
-dacpo_ply_rows_read(FILE* f,
-                    const dacpo_ply_rows* rows,
-                    unsigned long long first,
-                    size_t count,
-                    float* xyz,
-                    char* err,
-                    size_t errlen)
-{
-  return rows_walk(f, rows, first, count, emit_float, xyz, err, errlen);
-}
-
-int
-dacpo_ply_rows_read_double(FILE* f,
-                           const dacpo_ply_rows* rows,
-                           unsigned long long first,
-                           size_t count,
-                           double* xyz,
-                           char* err,
-                           size_t errlen)
-{
-  return rows_walk(f, rows, first, count, emit_double, xyz, err, errlen);
-}
-
-int
-dacpo_ply_rows_read_raw(FILE* f,
-                        const dacpo_ply_rows* rows,
-                        unsigned long long first,
-                        size_t count,
-                        unsigned char* out,
-                        char* err,
-                        size_t errlen)
-{
-  return rows_walk(f, rows, first, count, emit_raw, out, err, errlen);
-}
-
-size_t
-dacpo_ply_rows_xyz_bytes(const dacpo_ply_rows* rows)
-{
-  size_t b = 0;
-  for (int k = 0; k < 3; ++k)
-    b += type_size((ply_type)rows->type[k]);
-  return b;
-}
-
-int
-dacpo_ply_rows_exact_in_float(const dacpo_ply_rows* rows)
-{
-  return exact_in_float((ply_type)rows->type[0]) && exact_in_float((ply_type)rows->type[1]) &&
-         exact_in_float((ply_type)rows->type[2]);
-}
-
-const char*
-dacpo_ply_rows_type_name(const dacpo_ply_rows* rows, int k)
-{
-  static const char* const names[] = {"float", "char", "uchar", "short", "ushort",
-                                      "int",   "uint", "float", "double"};
-  const int t = rows->type[k];
-  return t >= 0 && t < (int)(sizeof(names) / sizeof(names[0])) ? names[t] : "float";
-}
-
-int
-dacpo_ply_rows_set_origin(FILE* f, dacpo_ply_rows* rows, char* err, size_t errlen)
-{
-  double p[3] = {0.0, 0.0, 0.0};
-  if (rows->n > 0 && !dacpo_ply_rows_exact_in_float(rows)) {
-    const int rc = dacpo_ply_rows_read_double(f, rows, 0, 1, p, err, errlen);
-    if (rc != DACPO_PLY_OK)
-      return rc;
-  }
-  memcpy(rows->origin, p, sizeof(p));
-  return DACPO_PLY_OK;
 }
 
 void

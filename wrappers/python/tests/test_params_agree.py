@@ -44,10 +44,12 @@ def test_the_docstring_gives_the_c_defaults():
 
 
 def test_the_readme_table_gives_the_c_defaults():
-    readme = os.path.join(ROOT, "README.md")
+    """README.md has the user rows, docs/PARAMETERS.md the method switches."""
+    docs = [os.path.join(ROOT, "README.md"), os.path.join(ROOT, "docs", "PARAMETERS.md")]
     d = pcl_dacpo.default_params()
     checked = 0
-    for line in open(readme, encoding="utf-8"):
+    lines = [line for path in docs for line in open(path, encoding="utf-8")]
+    for line in lines:
         m = re.match(r"^\| `(\w+)` \| [^|]* \| ([^|]+) \|", line)
         if not m or m.group(1) not in d:
             continue
