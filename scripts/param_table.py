@@ -20,13 +20,13 @@ HEADER = os.path.join(ROOT, "c_core", "include", "dacpo", "dacpo_param_table.h")
 BEGIN = re.compile(r"<!-- scripts/param_table.py: begin (USER|EXPERT) -->")
 END = "<!-- scripts/param_table.py: end -->"
 TITLES = {"USER": "Set by users", "EXPERT": "Method switches (for measurement and ablation)"}
-ROW = re.compile(r'DACPO_PARAM\((\w+), (\w+), ([^,]+), (USER|EXPERT), (VALUE|SPECIAL|NONE), '
+ROW = re.compile(r'DACPO_PARAM\((\w+), \w+, (\w+), ([^,]+), (USER|EXPERT), (VALUE|SPECIAL|NONE), '
                  r'"([^"]*)",\s*\\?\s*"([^"]*)"\)')
 
 
 def rows():
     text = open(HEADER, encoding="utf-8").read()
-    text = text[text.index("#define DACPO_PARAMS()"):]
+    text = text[text.index("#define DACPO_PARAMS_BEFORE_VIEWPOINT()"):]
     found = ROW.findall(text)
     if not found:
         sys.exit(f"param_table: no rows found in {HEADER}")

@@ -23,7 +23,7 @@ std::vector<Field>
 tableFields()
 {
   std::vector<Field> f;
-#define DACPO_PARAM(kind, name, def, who, cli, flag, doc)                                                     \
+#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                                     \
   f.push_back({offsetof(dacpo_params, name), sizeof(dacpo_params::name),                      \
                alignof(decltype(dacpo_params::name)), #name});
   DACPO_PARAMS()
@@ -56,7 +56,7 @@ TEST(DacpoParamTable, InitGivesTheTableDefaults)
 {
   dacpo_params p;
   dacpo_params_init(&p);
-#define DACPO_PARAM(kind, name, def, who, cli, flag, doc)                                                     \
+#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                                     \
   EXPECT_EQ(p.name, static_cast<decltype(p.name)>(def)) << #name;
   DACPO_PARAMS()
 #undef DACPO_PARAM
@@ -73,7 +73,7 @@ TEST(DacpoParamsSet, EveryRowIsSettableByName)
   dacpo_params_init(&p);
   char msg[256] = "";
   size_t rows = 0;
-#define DACPO_PARAM(kind, name, def, who, cli, flag, doc)                                     \
+#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                     \
   ++rows;                                                                                     \
   EXPECT_EQ(dacpo_params_set(&p, #name, std::strcmp(#kind, "ENUM") ? "1" : "XX", msg,        \
                              sizeof(msg)),                                                    \

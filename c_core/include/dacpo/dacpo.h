@@ -23,6 +23,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dacpo_param_table.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -144,142 +146,16 @@ typedef enum dacpo_sign_policy {
 
 /**
  * \brief Parameters. Always start from dacpo_params_init(); new fields are only
- * ever appended.
+ * ever appended. One field per row of dacpo_param_table.h, whose rows give each
+ * field's type, default and contract.
  */
 typedef struct dacpo_params {
-  size_t k;             /**< k-NN graph size for segmentation/propagation, >= 2 (10) */
-  size_t normal_k;      /**< neighbourhood of PCA normals when estimated (16) */
-  int estimate_normals; /**< 1: compute PCA normals into the normals buffer;
-                             0: use the given normals as axes (default 0) */
-  size_t num_blocks;    /**< target number of blocks; 0 = automatic:
-                             n/625 clamped to [1, 400] (default 0) */
-  size_t ring_hops;     /**< overlap ring width in k-NN hops (3) */
-  double dipole_c;      /**< c of paper Eq. 1 (-1: by the scan kind, 1 for a single
-                             depth view or a scan of offset copies, 1.5
-                             otherwise; values >= 1). The paper
-                             uses 4 for clean and 2 for noisy scans. Larger c
-                             keeps the two sides of thin structures apart, smaller
-                             c resists depth noise; c = 1 leaves only the
-                             tangential alignment n.(I - r r^T).m, no "stacked,
-                             so opposite" vote - right where no part is seen from
-                             both sides. */
-  size_t dipole_orders; /**< M randomized BFS orders (5) */
-  size_t dipole_neighbors;    /**< K nearest placed points summed per decision (32) */
-  int dipole_final_sweep;     /**< re-decision sweeps after voting, repeated until no
-                                   point changes, at most this many; 0 = none (10) */
-  int ipsr_enabled;           /**< stage 3 on/off (1) */
-  size_t ipsr_max_iterations; /**< (20) */
-  dacpo_edge_weight edge_weight; /**< (DACPO_WEIGHT_VCR; with iPSR off the blocks
-                                       still get one Poisson mesh for it) */
-  double solver_time_limit;      /**< seconds for the 0-1 program (30) */
-  uint64_t seed;                 /**< all randomness derives from it (1) */
-  unsigned num_threads;          /**< 0 = all cores (0) */
-  dacpo_disconnected_policy disconnected; /**< (VIEWPOINT) */
-  int keep_mesh;            /**< 1: reconstruct one scene mesh from the final normals,
-                                 wound to agree with them; see dacpo_ctx_mesh() (0) */
-  size_t vcr_image_size;    /**< VCR image side in pixels, in [16, 4096] (128; the
-                                 paper: 400 for its 200 blocks) */
-  size_t vcr_views;         /**< VCR views: 12 = dodecahedron face centres (paper);
-                                 other counts use a Fibonacci sphere, [1, 256] (12) */
-  int vcr_perspective; /**< 1: perspective projection (paper); 0: orthographic (0) */
-  int vcr_boundary_factor;       /**< 1: I = C_B*C1*C2 (paper); 0: I = C1*C2 (1) */
-  size_t dipole_restarts;        /**< independent runs of stage 2 per block (M orders
-                                      each, voted point by point), 1..64 (16);
-                                      they stop after 4 that all agree */
-  double weak_edge_fraction;     /**< VIEWPOINT policy: block-graph edges whose
-                                      alpha + alpha-bar is below this fraction of the
-                                      median edge's do not join blocks into one part;
-                                      0 = parts are the k-NN components (1: every
-                                      edge below the median) */
-  dacpo_sign_policy sign_policy; /**< global sign (DACPO_SIGN_FREE_SPACE) */
-  double viewpoint[3];           /**< DACPO_SIGN_VIEWPOINT: the point normals face,
-                                      in the input's frame (0, 0, 0) */
-  double dipole_two_sheet;       /**< stage 2, thin two-sided parts: a neighbour pair
-                                      with near-parallel axes, each point lying off
-                                      the other's tangent plane by more than this many
-                                      times the local noise and 0.5 to 2 spacings, on
-                                      one side of a point and all around beneath it,
-                                      is the two faces of one thin part and must face
-                                      opposite ways (Eq. 1 alone aligns them for c < 3).
-                                      0 = off, the paper's field; < 0 = by the scan
-                                      kind: 0 for a single depth view (no part of one
-                                      view shows two faces), 3 otherwise (-1) */
-  double dipole_layers;          /**< stage 2, layered surfaces seen from one side:
-                                      neighbours with near-parallel axes lying off each
-                                      other's tangent plane by more than this many local
-                                      spacings are layers of one surface (depth
-                                      quantisation, registration) and get Eq. 1 with
-                                      c = 1 - the stacked term no longer says
-                                      "opposite" - in a block where under 3 % of the
-                                      points have a second sheet beneath them
-                                      (dipole_two_sheet). < 0 = by the scan kind:
-                                      0.5 for a single view, 2 otherwise (-1);
-                                      0 = off */
-  double dipole_sides;           /**< stage 2, parts thinner than the spacing (a
-                                      board 0.3-1 spacing thick): where a point's
-                                      parallel neighbours lie on two copies of one
-                                      smooth surface, one over the other, the pairs
-                                      across them face opposite ways, the point's
-                                      normal leans away from the other copy with this
-                                      weight (against the sum of its pair energies),
-                                      and stage 3 keeps the point's normal (its grid
-                                      cannot resolve the part). Only in blocks where
-                                      >= 5 % of the points show it. Any value > 0
-                                      turns the cue on; 0.001 (default) is pairs and
-                                      stage 3 only (the field just breaks ties).
-                                      Left out where the scan kind resolves to one
-                                      depth view or the floor shows offset copies
-                                      (dacpo_stats::layered_share, layered_copies).
-                                      0 = off (0.001) */
-  double cue_anchor;             /**< stage 5: the side cue (dipole_sides) is an
-                                      absolute sign - the two faces of a thin part look
-                                      away from each other - so a block where it fired
-                                      on >= 20 of its points is tied to "as stage 3
-                                      left it" (or "flipped", where the cue disagrees)
-                                      with this weight times the share of its cue
-                                      points that agree, scaled like an edge of Eq. 7
-                                      (n / (n + 100) for n cue points). 0 = off (1) */
-  double dipole_c_thin;          /**< stage 2, blocks with thin two-sided parts
-                                      (>= 3 % of the points have a second sheet
-                                      beneath them, dipole_two_sheet > 0): a
-                                      neighbour pair lying off each other's tangent
-                                      plane by more than dipole_two_sheet x the
-                                      local noise is geometry, not noise, and gets
-                                      Eq. 1 with this c (the paper's clean-data
-                                      value) instead of dipole_c. Blocks seen from
-                                      one side keep dipole_c. 0 = off (4) */
-  int adaptive_normals;          /**< estimated normals: 1 = per point the
-                                      neighbourhood among 3/4, 1 and 3/2 x
-                                      normal_k that is flattest (lowest
-                                      surface variation; another scale than
-                                      normal_k only where its neighbours do
-                                      not form a strip); the k-NN graph then
-                                      keeps 3/2 x normal_k neighbours. 0 =
-                                      normal_k alone (1) */
-  dacpo_scan_kind scan_kind;     /**< single depth view or many views (AUTO: decided
-                                      from the sampling density, see
-                                      dacpo_stats::scan_kind). A single view gets
-                                      c = 1, layers at 0.5 spacings, no two-sheet
-                                      rule and no side cue where those are left at
-                                      -1 / default; many views get c = 1.5, layers
-                                      at 2 spacings and the thin-part rules, unless
-                                      the floor shows offset copies (then c = 1 and
-                                      no two-sheet rule or side cue) (AUTO) */
-  double seam_dipole;            /**< stage 4 with VCR weights: the dipole energy
-                                      across each block seam (Eq. 2 over the k-NN
-                                      pairs joining the two blocks) is added as a
-                                      second measure, this x its evidence over its
-                                      typical edge's, VCR over its own. 0 = VCR
-                                      alone (0.5) */
-  size_t surface_vote;           /**< after the 0-1 program: on every smooth surface
-                                      of at least this many points (neighbours
-                                      with axes within 8 degrees of parallel, each
-                                      in the other's tangent plane), points
-                                      against the surface's majority are turned
-                                      over, unless they are over a fifth of it
-                                      (two faces of a thin part merged). Mends
-                                      blocks a junction left half or wholly
-                                      inside out. 0 = off (500) */
+#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc) type name;
+  DACPO_PARAMS_BEFORE_VIEWPOINT()
+  double viewpoint[3]; /**< DACPO_SIGN_VIEWPOINT: the point normals face, in the
+                            input's frame (0, 0, 0) */
+  DACPO_PARAMS_AFTER_VIEWPOINT()
+#undef DACPO_PARAM
 } dacpo_params;
 
 /** \brief Fill \a params with the defaults documented above. NULL-safe. */

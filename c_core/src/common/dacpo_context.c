@@ -77,7 +77,7 @@ dacpo_params_init(dacpo_params* p)
     return;
   memset(p, 0, sizeof(*p)); /* viewpoint (0, 0, 0) */
   /* every default from the one table (dacpo_param_table.h) */
-#define DACPO_PARAM(kind, name, def, who, cli, flag, doc) p->name = def;
+#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc) p->name = def;
   DACPO_PARAMS()
 #undef DACPO_PARAM
 }
@@ -174,7 +174,7 @@ dacpo_params_set(dacpo_params* params,
   dacpo_params tmp = *params;
   unsigned long long u = 0;
   int e = 0;
-#define DACPO_PARAM(kind, field, def, who, cli, flag, doc)                     \
+#define DACPO_PARAM(kind, type, field, def, who, cli, flag, doc)                     \
   if (strcmp(name, #field) == 0) {                                             \
     if (!(DACPO_SET_##kind(field)))                                            \
       return bad_field(message,                                                \
