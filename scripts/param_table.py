@@ -5,7 +5,11 @@
 default and contract of every row. A block between
 "<!-- scripts/param_table.py: begin USER -->" (or EXPERT) and
 "<!-- scripts/param_table.py: end -->" gets the rows of that audience: the
-README has the USER rows, docs/PARAMETERS.md the method switches.
+README has the USER rows, docs/PARAMETERS.md the method switches. In the
+Python stub (wrappers/python/pcl_dacpo/__init__.pyi) the block between
+"# scripts/param_table.py: begin KEYWORDS" and "# scripts/param_table.py: end"
+gets orient()'s keyword of every row (the package takes all but
+estimate_normals and keep_mesh, which it sets itself).
 
   scripts/param_table.py                 print both tables
   scripts/param_table.py --write F...    fill every block of each file
@@ -17,8 +21,11 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 HEADER = os.path.join(ROOT, "c_core", "include", "dacpo", "dacpo_param_table.h")
-BEGIN = re.compile(r"<!-- scripts/param_table.py: begin (USER|EXPERT) -->")
-END = "<!-- scripts/param_table.py: end -->"
+BEGIN = re.compile(r"(?:<!--|#) scripts/param_table.py: begin (USER|EXPERT|KEYWORDS)(?: -->)?")
+END = re.compile(r"[ \t]*(?:<!--|#) scripts/param_table.py: end")
+NOT_KEYWORDS = ("estimate_normals", "keep_mesh")
+PY_TYPES = {"SIZE": "int", "INT": "int", "UINT": "int", "U64": "int", "REAL": "float",
+            "FLAG": "bool", "ENUM": "Union[str, int]"}
 TITLES = {"USER": "Set by users", "EXPERT": "Method switches (for measurement and ablation)"}
 ROW = re.compile(r'DACPO_PARAM\((\w+), \w+, (\w+), ([^,]+), (USER|EXPERT), (VALUE|SPECIAL|NONE), '
                  r'"([^"]*)",\s*\\?\s*"([^"]*)"\)')
@@ -42,7 +49,17 @@ def default_text(kind, value):
     return value
 
 
+def keywords():
+    out = []
+    for kind, name, value, audience, cli, flag, doc in rows():
+        if name not in NOT_KEYWORDS:
+            out.append(f"    {name}: {PY_TYPES[kind]} = ...,")
+    return "\n".join(out) + "\n"
+
+
 def markdown(who):
+    if who == "KEYWORDS":
+        return keywords()
     out = [f"**{TITLES[who]}**", "", "| field | CLI | default | contract |", "|---|---|---|---|"]
     for kind, name, value, audience, cli, flag, doc in rows():
         if audience != who:
@@ -57,11 +74,12 @@ def filled(path):
     text = open(path, encoding="utf-8").read()
     out, pos, blocks = [], 0, 0
     for m in BEGIN.finditer(text):
-        end = text.find(END, m.end())
-        if end < 0:
-            sys.exit(f"param_table: {path}: no {END} after {m.group(0)}")
-        out += [text[pos:m.end()], "\n" + markdown(m.group(1)) + "\n"]
-        pos, blocks = end, blocks + 1
+        e = END.search(text, m.end())
+        if not e:
+            sys.exit(f"param_table: {path}: no end marker after {m.group(0)}")
+        table = markdown(m.group(1))
+        out += [text[pos:m.end()], "\n" + (table if m.group(1) == "KEYWORDS" else table + "\n")]
+        pos, blocks = e.start(), blocks + 1
     if not blocks:
         sys.exit(f"param_table: {path} has no scripts/param_table.py block")
     return text, "".join(out) + text[pos:]
