@@ -27,8 +27,8 @@ NOT_KEYWORDS = ("estimate_normals", "keep_mesh")
 PY_TYPES = {"SIZE": "int", "INT": "int", "UINT": "int", "U64": "int", "REAL": "float",
             "FLAG": "bool", "ENUM": "Union[str, int]"}
 TITLES = {"USER": "Set by users", "EXPERT": "Method switches (for measurement and ablation)"}
-ROW = re.compile(r'DACPO_PARAM\((\w+), \w+, (\w+), ([^,]+), (USER|EXPERT), (VALUE|SPECIAL|NONE), '
-                 r'"([^"]*)",\s*\\?\s*"([^"]*)"\)')
+ROW = re.compile(r'DACPO_PARAM\((\w+), \w+, (\w+), ([^,]+), ([^,]+), ([^,]+), (USER|EXPERT), '
+                 r'(VALUE|SPECIAL|NONE), "([^"]*)",\s*\\?\s*"([^"]*)"\)')
 
 
 def rows():
@@ -49,9 +49,21 @@ def default_text(kind, value):
     return value
 
 
+def range_text(kind, lo, hi):
+    """The accepted range as the tables show it."""
+    if kind in ("ENUM", "FLAG"):
+        return "0 or 1" if kind == "FLAG" else "—"
+    inf = lambda v: v.strip().lstrip("-") == "DACPO_INF"
+    if inf(lo) and inf(hi):
+        return "any"
+    if inf(hi):
+        return f"≥ {lo}"
+    return f"[{lo}, {hi}]"
+
+
 def keywords():
     out = []
-    for kind, name, value, audience, cli, flag, doc in rows():
+    for kind, name, value, lo, hi, audience, cli, flag, doc in rows():
         if name not in NOT_KEYWORDS:
             out.append(f"    {name}: {PY_TYPES[kind]} = ...,")
     return "\n".join(out) + "\n"
@@ -60,12 +72,14 @@ def keywords():
 def markdown(who):
     if who == "KEYWORDS":
         return keywords()
-    out = [f"**{TITLES[who]}**", "", "| field | CLI | default | contract |", "|---|---|---|---|"]
-    for kind, name, value, audience, cli, flag, doc in rows():
+    out = [f"**{TITLES[who]}**", "", "| field | CLI | default | range | contract |",
+           "|---|---|---|---|---|"]
+    for kind, name, value, lo, hi, audience, cli, flag, doc in rows():
         if audience != who:
             continue
         shown = ", ".join(f"`{f.strip()}`" for f in flag.split(",")) if flag else "—"
-        out.append(f"| `{name}` | {shown} | {default_text(kind, value)} | {doc} |")
+        out.append(f"| `{name}` | {shown} | {default_text(kind, value)} | "
+                   f"{range_text(kind, lo, hi)} | {doc} |")
     return "\n".join(out) + "\n"
 
 

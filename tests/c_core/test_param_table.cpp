@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <type_traits>
 #include <cstddef>
 #include <cstring>
 #include <vector>
@@ -23,7 +25,7 @@ std::vector<Field>
 tableFields()
 {
   std::vector<Field> f;
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                                     \
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)                                                     \
   f.push_back({offsetof(dacpo_params, name), sizeof(dacpo_params::name),                      \
                alignof(decltype(dacpo_params::name)), #name});
   DACPO_PARAMS()
@@ -56,7 +58,7 @@ TEST(DacpoParamTable, InitGivesTheTableDefaults)
 {
   dacpo_params p;
   dacpo_params_init(&p);
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                                     \
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)                                                     \
   EXPECT_EQ(p.name, static_cast<decltype(p.name)>(def)) << #name;
   DACPO_PARAMS()
 #undef DACPO_PARAM
@@ -73,7 +75,7 @@ TEST(DacpoParamsSet, EveryRowIsSettableByName)
   dacpo_params_init(&p);
   char msg[256] = "";
   size_t rows = 0;
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                     \
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)                                     \
   ++rows;                                                                                     \
   EXPECT_EQ(dacpo_params_set(&p, #name, std::strcmp(#kind, "ENUM") ? "1" : "XX", msg,        \
                              sizeof(msg)),                                                    \
@@ -134,4 +136,61 @@ TEST(DacpoParamsSet, BadValuesLeaveTheParamsAsTheyWere)
   EXPECT_EQ(dacpo_params_set(&p, "viewpoint", "1", msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_params_set(nullptr, "k", "1", msg, sizeof(msg)), DACPO_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(dacpo_params_set(&p, "k", nullptr, nullptr, 0), DACPO_ERR_INVALID_ARGUMENT);
+}
+
+namespace {
+
+// A field set to v: validate's verdict, and whether its message names the field.
+template <typename T>
+bool
+acceptsValue(T dacpo_params::*field, double v, const char* name, bool* named)
+{
+  dacpo_params p;
+  dacpo_params_init(&p);
+  if constexpr (std::is_enum<T>::value)
+    p.*field = static_cast<T>(static_cast<int>(v));
+  else
+    p.*field = static_cast<T>(v);
+  char msg[256] = "";
+  const bool ok = dacpo_params_validate(&p, msg, sizeof(msg)) == DACPO_OK;
+  *named = std::strstr(msg, name) != nullptr;
+  return ok;
+}
+
+// Both ends of a row's range are accepted; one step beyond either (where the
+// field's type can hold it) is refused with a message that names the field.
+template <typename T>
+void
+checkRange(T dacpo_params::*field, const char* name, double lo, double hi)
+{
+  const bool real = std::is_floating_point<T>::value;
+  const double step = real ? 1e-6 * std::max(1.0, std::fabs(lo)) : 1.0;
+  bool named = false;
+  if (lo > -DACPO_INF) {
+    EXPECT_TRUE(acceptsValue(field, lo, name, &named)) << name << " = " << lo;
+    if (real || lo >= 1.0 || std::is_signed<T>::value || std::is_enum<T>::value) {
+      EXPECT_FALSE(acceptsValue(field, lo - step, name, &named)) << name << " below " << lo;
+      EXPECT_TRUE(named) << name;
+    }
+  }
+  if (hi < DACPO_INF) {
+    const double hstep = real ? 1e-6 * std::max(1.0, std::fabs(hi)) : 1.0;
+    EXPECT_TRUE(acceptsValue(field, hi, name, &named)) << name << " = " << hi;
+    EXPECT_FALSE(acceptsValue(field, hi + hstep, name, &named)) << name << " above " << hi;
+    EXPECT_TRUE(named) << name;
+  }
+}
+
+} // namespace
+
+// The table's min and max columns are what dacpo_params_validate() enforces.
+TEST(DacpoParamTable, EveryRowsRangeIsEnforced)
+{
+  size_t rows = 0;
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)       \
+  ++rows;                                                                      \
+  checkRange(&dacpo_params::name, #name, static_cast<double>(lo), static_cast<double>(hi));
+  DACPO_PARAMS()
+#undef DACPO_PARAM
+  EXPECT_GE(rows, 30u);
 }

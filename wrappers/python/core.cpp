@@ -81,7 +81,7 @@ defaultParams()
   dacpo_params p;
   dacpo_params_init(&p);
   py::dict d;
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                              \
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)                                              \
   if (pythonKeyword(#name))                                                            \
     d[#name] = toPy##kind(p.name);
   DACPO_PARAMS()
@@ -151,7 +151,7 @@ toParams(const py::dict& d)
 {
   dacpo_params p;
   dacpo_params_init(&p);
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc)                                              \
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)                                              \
   if (pythonKeyword(#name))                                                            \
     fromPy##kind(d, #name, p.name);
   DACPO_PARAMS()

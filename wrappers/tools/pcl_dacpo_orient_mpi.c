@@ -149,7 +149,7 @@ param_option(const char* flag)
     return #name;
 #define DACPO_MPI_SPECIAL(name, f)
 #define DACPO_MPI_NONE(name, f)
-#define DACPO_PARAM(kind, type, name, def, who, cli, f, doc) DACPO_MPI_##cli(name, f)
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, f, doc) DACPO_MPI_##cli(name, f)
   DACPO_PARAMS()
 #undef DACPO_PARAM
   return NULL;
@@ -784,7 +784,7 @@ print_param_options(const dacpo_params* d)
   print_param_line(f " X", doc, def);
 #define DACPO_MPI_HELP_SPECIAL(kind, name, f, doc)
 #define DACPO_MPI_HELP_NONE(kind, name, f, doc)
-#define DACPO_PARAM(kind, type, name, def_, who, cli, f, doc)                        \
+#define DACPO_PARAM(kind, type, name, def_, lo, hi, who, cli, f, doc)                        \
   DACPO_MPI_HELP_##cli(kind, name, f, doc)
   DACPO_PARAMS()
 #undef DACPO_PARAM

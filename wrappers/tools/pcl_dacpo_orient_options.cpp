@@ -90,7 +90,7 @@ showNumber(const dacpo_params& d)
 
 const OptionSpec kOptions[] = {
     /* every VALUE row of the parameter table: "flag X" */
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc) DACPO_CLI_##cli(kind, name, who, flag, doc)
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc) DACPO_CLI_##cli(kind, name, who, flag, doc)
     DACPO_PARAMS()
 #undef DACPO_PARAM
     {"-estimate",

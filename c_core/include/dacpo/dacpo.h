@@ -150,7 +150,7 @@ typedef enum dacpo_sign_policy {
  * field's type, default and contract.
  */
 typedef struct dacpo_params {
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc) type name;
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc) type name;
   DACPO_PARAMS_BEFORE_VIEWPOINT()
   double viewpoint[3]; /**< DACPO_SIGN_VIEWPOINT: the point normals face, in the
                             input's frame (0, 0, 0) */

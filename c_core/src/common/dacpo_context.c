@@ -77,7 +77,7 @@ dacpo_params_init(dacpo_params* p)
     return;
   memset(p, 0, sizeof(*p)); /* viewpoint (0, 0, 0) */
   /* every default from the one table (dacpo_param_table.h) */
-#define DACPO_PARAM(kind, type, name, def, who, cli, flag, doc) p->name = def;
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc) p->name = def;
   DACPO_PARAMS()
 #undef DACPO_PARAM
 }
@@ -174,7 +174,7 @@ dacpo_params_set(dacpo_params* params,
   dacpo_params tmp = *params;
   unsigned long long u = 0;
   int e = 0;
-#define DACPO_PARAM(kind, type, field, def, who, cli, flag, doc)                     \
+#define DACPO_PARAM(kind, type, field, def, lo, hi, who, cli, flag, doc)                     \
   if (strcmp(name, #field) == 0) {                                             \
     if (!(DACPO_SET_##kind(field)))                                            \
       return bad_field(message,                                                \
@@ -190,166 +190,40 @@ dacpo_params_set(dacpo_params* params,
   return bad_field(message, message_size, "no parameter is called '%s'", name);
 }
 
-/* The k-NN graph, normals and blocks (stages 0-1). */
+/* Every field within its row's [min, max] (dacpo_param_table.h); a real
+ * also finite. An enum's range is its values. */
 static dacpo_status
-check_graph(const dacpo_params* p, char* message, size_t size)
+check_ranges(const dacpo_params* p, char* message, size_t size)
 {
-  if (p->k < 2)
-    return bad_field(message,
-                     size,
-                     "k must be >= 2 (got %zu): a 1-NN graph splits every surface into "
-                     "pairs",
-                     p->k);
-  if (p->k > 1000)
-    return bad_field(message, size, "k must be <= 1000 (got %zu)", p->k);
-  if (p->estimate_normals && (p->normal_k < 3 || p->normal_k > 1000))
-    return bad_field(
-        message, size, "normal_k must be in [3, 1000] (got %zu)", p->normal_k);
-  if (p->num_blocks > 100000)
-    return bad_field(
-        message, size, "num_blocks must be <= 100000 (got %zu)", p->num_blocks);
-  if (p->ring_hops > 64)
-    return bad_field(message, size, "ring_hops must be <= 64 (got %zu)", p->ring_hops);
+#define DACPO_PARAM(kind, type, name, def, lo, hi, who, cli, flag, doc)       \
+  {                                                                            \
+    const double v = (double)p->name;                                          \
+    if (!(v >= (double)(lo) && v <= (double)(hi)) || !isfinite(v))             \
+      return strcmp(#kind, "ENUM") == 0                                        \
+                 ? bad_field(message, size, #name " has an unknown value %d",  \
+                             (int)p->name)                                     \
+                 : bad_field(message, size, #name " must be in [%g, %g] (got %g)", \
+                             (double)(lo), (double)(hi), v);                   \
+  }
+  DACPO_PARAMS()
+#undef DACPO_PARAM
   return DACPO_OK;
 }
 
-/* Stage 2: c and the sizes of the randomized search. */
+/* What a range cannot say. */
 static dacpo_status
-check_dipole_counts(const dacpo_params* p, char* message, size_t size)
+check_special(const dacpo_params* p, char* message, size_t size)
 {
-  if (!(p->dipole_c >= 1.0 || p->dipole_c < 0.0) || !isfinite(p->dipole_c))
+  if (p->dipole_c >= 0.0 && p->dipole_c < 1.0)
     return bad_field(message,
                      size,
-                     "dipole_c must be finite and >= 1 (paper Eq. 1; < 0: by the scan "
-                     "kind), got %g",
+                     "dipole_c must be >= 1 (paper Eq. 1), or negative for the scan "
+                     "kind's value (got %g)",
                      p->dipole_c);
-  if (p->dipole_orders < 1 || p->dipole_orders > 16)
-    return bad_field(
-        message, size, "dipole_orders must be in [1, 16] (got %zu)", p->dipole_orders);
-  if (p->dipole_neighbors < 1 || p->dipole_neighbors > 1024)
-    return bad_field(message,
-                     size,
-                     "dipole_neighbors must be in [1, 1024] (got %zu)",
-                     p->dipole_neighbors);
-  if (p->dipole_restarts < 1 || p->dipole_restarts > 64)
-    return bad_field(message,
-                     size,
-                     "dipole_restarts must be in [1, 64] (got %zu)",
-                     p->dipole_restarts);
-  return DACPO_OK;
-}
-
-/* Parts and the global sign. */
-static dacpo_status
-check_parts_sign(const dacpo_params* p, char* message, size_t size)
-{
-  if (!(p->weak_edge_fraction >= 0.0) || !(p->weak_edge_fraction <= 1.0))
-    return bad_field(message,
-                     size,
-                     "weak_edge_fraction must be in [0, 1] (got %g)",
-                     p->weak_edge_fraction);
-  if (p->sign_policy != DACPO_SIGN_FREE_SPACE &&
-      p->sign_policy != DACPO_SIGN_VIEWPOINT && p->sign_policy != DACPO_SIGN_KEEP)
-    return bad_field(message,
-                     size,
-                     "sign_policy must be FREE_SPACE, VIEWPOINT or KEEP (got %d)",
-                     (int)p->sign_policy);
   if (p->sign_policy == DACPO_SIGN_VIEWPOINT &&
       !(isfinite(p->viewpoint[0]) && isfinite(p->viewpoint[1]) &&
         isfinite(p->viewpoint[2])))
     return bad_field(message, size, "viewpoint must be finite");
-  return DACPO_OK;
-}
-
-/* Sweeps, iPSR iterations, edge weights and the 0-1 solver. */
-static dacpo_status
-check_iterations_solver(const dacpo_params* p, char* message, size_t size)
-{
-  if (p->dipole_final_sweep < 0 || p->dipole_final_sweep > 1000)
-    return bad_field(message,
-                     size,
-                     "dipole_final_sweep must be in [0, 1000] (got %d)",
-                     p->dipole_final_sweep);
-  if (p->ipsr_max_iterations > 1000)
-    return bad_field(message,
-                     size,
-                     "ipsr_max_iterations must be <= 1000 (got %zu)",
-                     p->ipsr_max_iterations);
-  if (p->edge_weight != DACPO_WEIGHT_DIPOLE_BOUNDARY &&
-      p->edge_weight != DACPO_WEIGHT_VCR && p->edge_weight != DACPO_WEIGHT_OVERLAP)
-    return bad_field(
-        message, size, "edge_weight has an unknown value %d", (int)p->edge_weight);
-  if (!(p->solver_time_limit > 0.0) || !isfinite(p->solver_time_limit))
-    return bad_field(message,
-                     size,
-                     "solver_time_limit must be finite and > 0 (got %g)",
-                     p->solver_time_limit);
-  return DACPO_OK;
-}
-
-/* Stage 2 field rules: two sheets, layers. */
-static dacpo_status
-check_dipole_rules(const dacpo_params* p, char* message, size_t size)
-{
-  if (!isfinite(p->dipole_two_sheet))
-    return bad_field(message,
-                     size,
-                     "dipole_two_sheet must be finite (got %g; < 0 = by the scan kind)",
-                     p->dipole_two_sheet);
-  if (p->adaptive_normals != 0 && p->adaptive_normals != 1)
-    return bad_field(message,
-                     size,
-                     "adaptive_normals must be 0 or 1 (got %d)",
-                     p->adaptive_normals);
-  if (!(p->dipole_c_thin >= 0.0) || !isfinite(p->dipole_c_thin))
-    return bad_field(message,
-                     size,
-                     "dipole_c_thin must be finite and >= 0 (got %g)",
-                     p->dipole_c_thin);
-  if (!isfinite(p->dipole_layers))
-    return bad_field(message,
-                     size,
-                     "dipole_layers must be finite (got %g; < 0 = by the scan kind)",
-                     p->dipole_layers);
-  if (p->scan_kind != DACPO_SCAN_AUTO && p->scan_kind != DACPO_SCAN_SINGLE_VIEW &&
-      p->scan_kind != DACPO_SCAN_MULTI_VIEW)
-    return bad_field(
-        message, size, "scan_kind has an unknown value %d", (int)p->scan_kind);
-  if (!(p->dipole_sides >= 0.0) || !isfinite(p->dipole_sides))
-    return bad_field(message,
-                     size,
-                     "dipole_sides must be finite and >= 0 (got %g)",
-                     p->dipole_sides);
-  if (!(p->cue_anchor >= 0.0) || !isfinite(p->cue_anchor))
-    return bad_field(
-        message, size, "cue_anchor must be finite and >= 0 (got %g)", p->cue_anchor);
-  if (!(p->seam_dipole >= 0.0) || !isfinite(p->seam_dipole))
-    return bad_field(
-        message, size, "seam_dipole must be finite and >= 0 (got %g)", p->seam_dipole);
-  return DACPO_OK;
-}
-
-/* VCR views, threads and the disconnected-part policy. */
-static dacpo_status
-check_vcr_run(const dacpo_params* p, char* message, size_t size)
-{
-  if (p->vcr_image_size < 16 || p->vcr_image_size > 4096)
-    return bad_field(message,
-                     size,
-                     "vcr_image_size must be in [16, 4096] (got %zu)",
-                     p->vcr_image_size);
-  if (p->vcr_views < 1 || p->vcr_views > 256)
-    return bad_field(
-        message, size, "vcr_views must be in [1, 256] (got %zu)", p->vcr_views);
-  if (p->num_threads > 1024)
-    return bad_field(
-        message, size, "num_threads must be <= 1024 (got %u)", p->num_threads);
-  if (p->disconnected != DACPO_DISCONNECTED_SEPARATE &&
-      p->disconnected != DACPO_DISCONNECTED_ERROR &&
-      p->disconnected != DACPO_DISCONNECTED_BRIDGE &&
-      p->disconnected != DACPO_DISCONNECTED_VIEWPOINT)
-    return bad_field(
-        message, size, "disconnected has an unknown value %d", (int)p->disconnected);
   return DACPO_OK;
 }
 
@@ -360,13 +234,8 @@ dacpo_params_validate(const dacpo_params* p, char* message, size_t size)
     message[0] = '\0';
   if (!p)
     return bad_field(message, size, "params is NULL");
-  DACPO_TRY(check_graph(p, message, size));
-  DACPO_TRY(check_dipole_counts(p, message, size));
-  DACPO_TRY(check_parts_sign(p, message, size));
-  DACPO_TRY(check_iterations_solver(p, message, size));
-  DACPO_TRY(check_dipole_rules(p, message, size));
-  DACPO_TRY(check_vcr_run(p, message, size));
-  return DACPO_OK;
+  DACPO_TRY(check_ranges(p, message, size));
+  return check_special(p, message, size);
 }
 
 dacpo_status
