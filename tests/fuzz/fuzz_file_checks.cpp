@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer target: the tools' file loading (dacpo_tool::loadCloud2: the
-// structure checks of dacpo_tool_file_checks.h, then PCL's reader when they pass) on
-// arbitrary bytes named .pcd or .ply (first byte's low bit). Contract: no
+// structure checks of dacpo_tool_file_checks.cpp over the support library's
+// header parsers, then PCL's reader when they pass) on arbitrary bytes named
+// .pcd or .ply (first byte's low bit). Contract: no
 // crash or sanitizer report; a failure comes with a message; a success is a
 // cloud whose data size matches its header and which has x, y, z.
 #include <pcl/console/print.h>

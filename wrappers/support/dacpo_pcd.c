@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* PCD input/output (see dacpo_pcd.h). The header is read line by line; the
- * point records are then either whitespace-separated text (ascii) or packed
- * little-endian records of the fields in header order (binary). */
+/* PCD input/output (see dacpo_pcd.h). The header is parsed by
+ * dacpo_pcd_header.c; the point records are then either whitespace-separated
+ * text (ascii), packed little-endian records of the fields in header order
+ * (binary) or those LZF-compressed field by field (binary_compressed). */
 #include "dacpo_pcd.h"
 
 #include "dacpo_support_err.h"
@@ -15,27 +16,7 @@
 #include <string.h>
 #include <strings.h>
 
-#define PCD_MAX_FIELDS 64
-#define PCD_MAX_LINE 4096
 #define PCD_MAX_POINTS ((size_t)1 << 34) /* beyond any file this tool can hold */
-
-typedef struct pcd_field {
-  char name[64];
-  int size;      /* bytes per value: 1, 2, 4, 8 */
-  char type;     /* I, U, F */
-  size_t count;  /* values */
-  size_t offset; /* bytes from the record start (binary) */
-} pcd_field;
-
-typedef struct pcd_header {
-  pcd_field f[PCD_MAX_FIELDS];
-  int nf;
-  size_t points;
-  size_t width, height;
-  int have_points, have_width, have_height, have_size, have_type;
-  char data[32];
-  size_t record; /* bytes per point (binary) */
-} pcd_header;
 
 int
 dacpo_is_pcd_path(const char* path)
@@ -51,166 +32,20 @@ dacpo_is_ply_path(const char* path)
   return len >= 4 && strcasecmp(path + len - 4, ".ply") == 0;
 }
 
-/* Strict unsigned number of a header value. */
+/* The header (dacpo_pcd_read_header) and what this reader needs of it: the
+ * number of points (POINTS, or WIDTH x HEIGHT), x, y and z, float coordinates
+ * and normals of 4 or 8 bytes; finds x, y, z and the normals (idx[0..5], -1
+ * when absent). */
 static int
-parse_count(const char* s, size_t* out)
+read_header(FILE* fp,
+            const char* path,
+            dacpo_pcd_header* h,
+            int idx[6],
+            char* err,
+            size_t errlen)
 {
-  if (!s || !isdigit((unsigned char)*s))
+  if (dacpo_pcd_read_header(fp, path, h, err, errlen) != DACPO_PLY_OK)
     return 0;
-  errno = 0;
-  char* end = NULL;
-  unsigned long long v = strtoull(s, &end, 10);
-  if (errno || *end != '\0')
-    return 0;
-  *out = (size_t)v;
-  return 1;
-}
-
-/* Splits line into at most max tokens (in place); returns the number. */
-static int
-tokens(char* line, char** tok, int max)
-{
-  int m = 0;
-  for (char* s = strtok(line, " \t\r\n"); s && m < max; s = strtok(NULL, " \t\r\n"))
-    tok[m++] = s;
-  return m;
-}
-
-/* A SIZE, TYPE or COUNT line: one value per field (val[0..nv)). */
-static int
-field_values(
-    pcd_header* h, const char* key, char** val, int nv, int lineno, char* err, size_t errlen)
-{
-  if (nv != h->nf) {
-    dacpo_support_err(err,
-                      errlen,
-                      "header line %d: %s has %d values for %d fields",
-                      lineno,
-                      key,
-                      nv,
-                      h->nf);
-    return 0;
-  }
-  for (int i = 0; i < h->nf; ++i) {
-    const char* v = val[i];
-    size_t x = 0;
-    if (key[0] == 'T') {
-      if (strlen(v) != 1 || !strchr("IUF", v[0])) {
-        dacpo_support_err(
-            err, errlen, "header line %d: TYPE '%s' is not I, U or F", lineno, v);
-        return 0;
-      }
-      h->f[i].type = v[0];
-    }
-    else if (!parse_count(v, &x) || x == 0 || x > (key[0] == 'S' ? 8u : 1000000u) ||
-             (key[0] == 'S' && x != 1 && x != 2 && x != 4 && x != 8)) {
-      dacpo_support_err(err, errlen, "header line %d: bad %s '%s'", lineno, key, v);
-      return 0;
-    }
-    else if (key[0] == 'S')
-      h->f[i].size = (int)x;
-    else
-      h->f[i].count = x;
-  }
-  h->have_size |= key[0] == 'S';
-  h->have_type |= key[0] == 'T';
-  return 1;
-}
-
-/* One header line (already without its newline) into h. */
-static int
-header_line(pcd_header* h, char* line, int lineno, char* err, size_t errlen)
-{
-  char* tok[PCD_MAX_FIELDS + 2];
-  const int m = tokens(line, tok, PCD_MAX_FIELDS + 2);
-  if (m == 0 || tok[0][0] == '#')
-    return 1;
-  const char* key = tok[0];
-  if (m > PCD_MAX_FIELDS + 1) {
-    dacpo_support_err(
-        err, errlen, "header line %d: more than %d values", lineno, PCD_MAX_FIELDS);
-    return 0;
-  }
-  if (!strcmp(key, "VERSION") || !strcmp(key, "VIEWPOINT"))
-    return 1;
-  if (!strcmp(key, "FIELDS") || !strcmp(key, "COLUMNS")) {
-    /* a (repeated) field list needs its SIZE and TYPE lines after it: the
-       sizes of an earlier list do not carry over (a size of 0 was read) */
-    h->nf = m - 1;
-    h->have_size = h->have_type = 0;
-    for (int i = 0; i < h->nf; ++i) {
-      snprintf(h->f[i].name, sizeof(h->f[i].name), "%s", tok[i + 1]);
-      h->f[i].count = 1;
-      h->f[i].size = 0;
-      h->f[i].type = 0;
-    }
-    return 1;
-  }
-  if (!strcmp(key, "SIZE") || !strcmp(key, "TYPE") || !strcmp(key, "COUNT"))
-    return field_values(h, key, tok + 1, m - 1, lineno, err, errlen);
-  size_t* target = !strcmp(key, "WIDTH")    ? &h->width
-                   : !strcmp(key, "HEIGHT") ? &h->height
-                   : !strcmp(key, "POINTS") ? &h->points
-                                            : NULL;
-  if (target) {
-    if (m != 2 || !parse_count(tok[1], target)) {
-      dacpo_support_err(err, errlen, "header line %d: bad %s", lineno, key);
-      return 0;
-    }
-    h->have_width |= target == &h->width;
-    h->have_height |= target == &h->height;
-    h->have_points |= target == &h->points;
-    return 1;
-  }
-  if (!strcmp(key, "DATA")) {
-    snprintf(h->data, sizeof(h->data), "%s", m > 1 ? tok[1] : "");
-    return 1;
-  }
-  dacpo_support_err(err,
-                    errlen,
-                    "header line %d: unknown keyword '%s' (not a PCD file?)",
-                    lineno,
-                    key);
-  return 0;
-}
-
-/* The header up to and including its DATA line; checks it and finds x, y, z and
- * the normals (idx[0..5], -1 when absent). */
-static int
-read_header(
-    FILE* fp, const char* path, pcd_header* h, int idx[6], char* err, size_t errlen)
-{
-  memset(h, 0, sizeof(*h));
-  char line[PCD_MAX_LINE];
-  int lineno = 0;
-  while (!h->data[0]) {
-    if (!fgets(line, sizeof(line), fp)) {
-      dacpo_support_err(
-          err, errlen, "'%s': no DATA line: not a PCD file or truncated header", path);
-      return 0;
-    }
-    ++lineno;
-    if (!strchr(line, '\n') && !feof(fp)) {
-      dacpo_support_err(err, errlen, "'%s': header line %d is too long", path, lineno);
-      return 0;
-    }
-    if (lineno == 1 && line[0] != '#' && strncmp(line, "VERSION", 7) &&
-        strncmp(line, "FIELDS", 6)) {
-      dacpo_support_err(err, errlen, "'%s' is not a PCD file", path);
-      return 0;
-    }
-    if (!header_line(h, line, lineno, err, errlen))
-      return 0;
-  }
-  if (strcmp(h->data, "binary") && strcmp(h->data, "ascii") &&
-      strcmp(h->data, "binary_compressed")) {
-    dacpo_support_err(err, errlen, "'%s': unknown DATA '%s'", path, h->data);
-    return 0;
-  }
-  if (h->nf == 0 || !h->have_size || !h->have_type) {
-    dacpo_support_err(err, errlen, "'%s': FIELDS, SIZE and TYPE are required", path);
-    return 0;
-  }
   if (!h->have_points) {
     if (!h->have_width) {
       dacpo_support_err(err, errlen, "'%s': neither POINTS nor WIDTH is given", path);
@@ -226,13 +61,10 @@ read_header(
   static const char* names[6] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
   for (int k = 0; k < 6; ++k)
     idx[k] = -1;
-  for (int i = 0; i < h->nf; ++i) {
-    h->f[i].offset = h->record;
-    h->record += (size_t)h->f[i].size * h->f[i].count;
+  for (int i = 0; i < h->nf; ++i)
     for (int k = 0; k < 6; ++k)
       if (!strcmp(h->f[i].name, names[k]) && idx[k] < 0)
         idx[k] = i;
-  }
   if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {
     dacpo_support_err(err, errlen, "'%s': the fields x, y and z are required", path);
     return 0;
@@ -255,7 +87,7 @@ read_header(
 
 /* The first value of field f in a binary record, as float. */
 static float
-binary_value(const unsigned char* rec, const pcd_field* f)
+binary_value(const unsigned char* rec, const dacpo_pcd_field* f)
 {
   const unsigned char* p = rec + f->offset;
   uint64_t u = 0;
@@ -291,7 +123,7 @@ store(dacpo_ply_cloud* out, size_t i, int k, float x)
 static int
 read_binary(FILE* fp,
             const char* path,
-            const pcd_header* h,
+            const dacpo_pcd_header* h,
             const int idx[6],
             dacpo_ply_cloud* out,
             char* err,
@@ -363,7 +195,7 @@ bytes_left(FILE* fp);
 static int
 read_compressed(FILE* fp,
                 const char* path,
-                const pcd_header* h,
+                const dacpo_pcd_header* h,
                 const int idx[6],
                 dacpo_ply_cloud* out,
                 char* err,
@@ -419,8 +251,8 @@ read_compressed(FILE* fp,
       if (idx[k] < 0)
         continue;
       /* a field's block starts at points x its offset in a record */
-      const pcd_field* f = &h->f[idx[k]];
-      pcd_field at = *f;
+      const dacpo_pcd_field* f = &h->f[idx[k]];
+      dacpo_pcd_field at = *f;
       at.offset = 0;
       const unsigned char* v =
           u + h->points * f->offset + i * (size_t)f->size * f->count;
@@ -435,14 +267,14 @@ read_compressed(FILE* fp,
 static int
 read_ascii(FILE* fp,
            const char* path,
-           const pcd_header* h,
+           const dacpo_pcd_header* h,
            const int idx[6],
            dacpo_ply_cloud* out,
            char* err,
            size_t errlen)
 {
   /* value position of each field's first value on a line */
-  size_t first[PCD_MAX_FIELDS], total = 0;
+  size_t first[DACPO_PCD_MAX_FIELDS], total = 0;
   for (int f = 0; f < h->nf; ++f) {
     first[f] = total;
     total += h->f[f].count;
@@ -494,7 +326,8 @@ bytes_left(FILE* fp)
 }
 
 static int
-fits_file(FILE* fp, const char* path, const pcd_header* h, char* err, size_t errlen)
+fits_file(
+    FILE* fp, const char* path, const dacpo_pcd_header* h, char* err, size_t errlen)
 {
   const long left = bytes_left(fp);
   if (left < 0) {
@@ -535,7 +368,7 @@ dacpo_pcd_read(const char* path, dacpo_ply_cloud* out, char* err, size_t errlen)
     dacpo_support_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
     return DACPO_PLY_ERR_IO;
   }
-  pcd_header h;
+  dacpo_pcd_header h;
   int idx[6];
   int rc = DACPO_PLY_ERR_FORMAT;
   if (read_header(fp, path, &h, idx, err, errlen) &&

@@ -4,11 +4,12 @@
  * This file reads; the writer is in dacpo_ply_write.c, and reading a binary
  * file's vertex rows in parts (dacpo_ply_rows_*) in dacpo_ply_rows.c.
  *
- * Reader: parses the header (elements, scalar and list properties, the three
- * formats), skips the elements before "vertex", then decodes the vertex rows
- * through a small buffered reader. Before allocating, the declared vertex count
- * is checked against the bytes left in the file, so a corrupt header cannot ask
- * for an absurd allocation; running out of data is reported as truncation.
+ * Reader: parses the header (dacpo_ply_header.c: elements, scalar and list
+ * properties, the three formats), skips the elements before "vertex", then
+ * decodes the vertex rows through a small buffered reader. Before allocating,
+ * the declared vertex count is checked against the bytes left in the file, so
+ * a corrupt header cannot ask for an absurd allocation; running out of data is
+ * reported as truncation.
  *
  * Cost: O(file size) time, 12 or 24 bytes per point of memory.
  * Failure modes: see the DACPO_PLY_ERR_* codes; never crashes.
@@ -26,9 +27,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define PLY_MAX_LINE 1024
-#define PLY_MAX_HEADER_LINES 4096
 
 /* ------------------------------------------------------------------------- */
 /* Buffered input.                                                            */
@@ -90,27 +88,29 @@ in_skip(ply_in* in, uint64_t len)
   return 0;
 }
 
-/* One header line without its terminator ("\n" or "\r\n").
- * Returns 0, -1 at end of file, -2 when the line is too long. */
+/* One header line without its terminator ("\n" or "\r\n"; the last line of
+ * the file may have none), cut to cap - 1 bytes (the rest of a longer line is
+ * skipped). Returns 0, -1 at end of file, -3 when the line holds a NUL byte. */
 static int
 in_line(ply_in* in, char* line, size_t cap)
 {
-  size_t k = 0;
-  int c;
+  size_t k = 0, got = 0;
+  int c, nul = 0;
   for (;;) {
     c = in_getc(in);
-    if (c < 0)
+    if (c < 0 && got == 0)
       return -1;
-    if (c == '\n')
+    if (c < 0 || c == '\n')
       break;
-    if (k + 1 >= cap)
-      return -2;
-    line[k++] = (char)c;
+    ++got;
+    nul |= c == '\0';
+    if (k + 1 < cap)
+      line[k++] = (char)c;
   }
   if (k > 0 && line[k - 1] == '\r')
     --k;
   line[k] = '\0';
-  return 0;
+  return nul ? -3 : 0;
 }
 
 /* Next whitespace-separated ASCII token; -1 at end of file, -2 when too long,
@@ -154,36 +154,14 @@ in_row_end(ply_in* in)
   return 0;
 }
 
-/* ------------------------------------------------------------------------- */
-/* Header model.                                                              */
-
-static ply_type
-parse_type(const char* s)
+int
+dacpo_ply_in_line(ply_in* in, char* line, size_t cap)
 {
-  static const struct {
-    const char* name;
-    ply_type type;
-  } names[] = {{"char", T_I8},
-               {"int8", T_I8},
-               {"uchar", T_U8},
-               {"uint8", T_U8},
-               {"short", T_I16},
-               {"int16", T_I16},
-               {"ushort", T_U16},
-               {"uint16", T_U16},
-               {"int", T_I32},
-               {"int32", T_I32},
-               {"uint", T_U32},
-               {"uint32", T_U32},
-               {"float", T_F32},
-               {"float32", T_F32},
-               {"double", T_F64},
-               {"float64", T_F64}};
-  for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i)
-    if (strcmp(s, names[i].name) == 0)
-      return names[i].type;
-  return T_NONE;
+  return in_line(in, line, cap);
 }
+
+/* ------------------------------------------------------------------------- */
+/* Types.                                                                     */
 
 size_t
 dacpo_ply_type_size(ply_type t)
@@ -212,16 +190,6 @@ int
 dacpo_ply_exact_in_float(ply_type t)
 {
   return t != T_F64 && t != T_I32 && t != T_U32;
-}
-
-static int
-prop_role(const char* name)
-{
-  static const char* const roles[6] = {"x", "y", "z", "nx", "ny", "nz"};
-  for (int i = 0; i < 6; ++i)
-    if (strcmp(name, roles[i]) == 0)
-      return i;
-  return -1;
 }
 
 /* Decode one binary value of type t at p (swap = file is big-endian). */
@@ -267,195 +235,6 @@ dacpo_ply_decode(const unsigned char* p, ply_type t, int swap)
     break;
   }
   return 0.0;
-}
-
-/* Parse an unsigned decimal count; -1 on anything else. */
-static int
-parse_count(const char* s, uint64_t* out)
-{
-  char* end;
-  unsigned long long v;
-  if (!s || *s < '0' || *s > '9')
-    return -1;
-  errno = 0;
-  v = strtoull(s, &end, 10);
-  if (errno != 0 || *end != '\0')
-    return -1;
-  *out = (uint64_t)v;
-  return 0;
-}
-
-/* Split s in place at spaces and tabs; at most max words (the rest is ignored,
- * extra words only make a line invalid through the callers' count checks). */
-static int
-split_words(char* s, char** words, int max)
-{
-  int n = 0;
-  while (*s) {
-    while (*s == ' ' || *s == '\t')
-      *s++ = '\0';
-    if (!*s)
-      break;
-    if (n == max)
-      return n + 1;
-    words[n++] = s;
-    while (*s && *s != ' ' && *s != '\t')
-      ++s;
-  }
-  return n;
-}
-
-/* A "format" line: ascii, binary_little_endian or binary_big_endian. */
-static int
-header_format(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
-{
-  if (nt < 2 || (strcmp(tok[1], "ascii") && strcmp(tok[1], "binary_little_endian") &&
-                 strcmp(tok[1], "binary_big_endian"))) {
-    dacpo_support_err(err,
-                      errlen,
-                      "unsupported PLY format '%s' (line %d)",
-                      nt > 1 ? tok[1] : "",
-                      lineno);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  h->format = strcmp(tok[1], "ascii") == 0                  ? FMT_ASCII
-              : strcmp(tok[1], "binary_little_endian") == 0 ? FMT_BLE
-                                                            : FMT_BBE;
-  return DACPO_PLY_OK;
-}
-
-/* An "element name count" line: a new element. */
-static int
-header_element(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
-{
-  ply_element* e;
-  if (nt != 3) {
-    dacpo_support_err(err, errlen, "bad element line %d", lineno);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  if (h->nel >= PLY_MAX_ELEMENTS) {
-    dacpo_support_err(
-        err, errlen, "more than %d elements in the PLY header", PLY_MAX_ELEMENTS);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  e = &h->el[h->nel++];
-  memset(e, 0, sizeof(*e));
-  snprintf(e->name, sizeof(e->name), "%s", tok[1]);
-  if (parse_count(tok[2], &e->count) != 0) {
-    dacpo_support_err(err,
-                      errlen,
-                      "bad count '%s' for element '%s' (line %d)",
-                      tok[2],
-                      e->name,
-                      lineno);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  return DACPO_PLY_OK;
-}
-
-/* A "property type name" or "property list count_type type name" line: a
- * property of the last element. */
-static int
-header_property(ply_header* h, char** tok, int nt, int lineno, char* err, size_t errlen)
-{
-  ply_element* e = h->nel > 0 ? &h->el[h->nel - 1] : NULL;
-  ply_prop* p;
-  if (!e) {
-    dacpo_support_err(err, errlen, "property before any element (line %d)", lineno);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  if (e->nprops >= PLY_MAX_PROPS) {
-    dacpo_support_err(
-        err, errlen, "more than %d properties in element '%s'", PLY_MAX_PROPS, e->name);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  p = &e->props[e->nprops];
-  if (nt == 5 && strcmp(tok[1], "list") == 0) {
-    p->count_type = parse_type(tok[2]);
-    p->type = parse_type(tok[3]);
-    p->role = -1;
-    if (p->count_type == T_NONE || p->count_type == T_F32 || p->count_type == T_F64 ||
-        p->type == T_NONE) {
-      dacpo_support_err(err, errlen, "bad list property types on line %d", lineno);
-      return DACPO_PLY_ERR_FORMAT;
-    }
-  }
-  else if (nt == 3) {
-    p->count_type = T_NONE;
-    p->type = parse_type(tok[1]);
-    p->role = prop_role(tok[2]);
-    if (p->type == T_NONE) {
-      dacpo_support_err(
-          err, errlen, "unknown property type '%s' on line %d", tok[1], lineno);
-      return DACPO_PLY_ERR_FORMAT;
-    }
-  }
-  else {
-    dacpo_support_err(err, errlen, "bad property line %d", lineno);
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  e->nprops++;
-  return DACPO_PLY_OK;
-}
-
-static int
-read_header(ply_in* in, ply_header* h, char* err, size_t errlen)
-{
-  char line[PLY_MAX_LINE];
-  int have_format = 0;
-  int rc = in_line(in, line, sizeof(line));
-  if (rc != 0 || strcmp(line, "ply") != 0) {
-    dacpo_support_err(err, errlen, "not a PLY file (first line is not 'ply')");
-    return DACPO_PLY_ERR_FORMAT;
-  }
-  for (int lineno = 2; lineno < PLY_MAX_HEADER_LINES; ++lineno) {
-    char* tok[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
-    int nt = 0;
-    int status;
-    rc = in_line(in, line, sizeof(line));
-    if (rc == -1) {
-      dacpo_support_err(err, errlen, "PLY header ends before 'end_header'");
-      return DACPO_PLY_ERR_FORMAT;
-    }
-    if (rc == -2) {
-      dacpo_support_err(err,
-                        errlen,
-                        "PLY header line %d is longer than %d bytes",
-                        lineno,
-                        PLY_MAX_LINE - 1);
-      return DACPO_PLY_ERR_FORMAT;
-    }
-    if (strncmp(line, "comment", 7) == 0 || strncmp(line, "obj_info", 8) == 0)
-      continue;
-    nt = split_words(line, tok, 6);
-    if (nt == 0)
-      continue;
-    if (strcmp(tok[0], "end_header") == 0) {
-      if (!have_format) {
-        dacpo_support_err(err, errlen, "PLY header has no 'format' line");
-        return DACPO_PLY_ERR_FORMAT;
-      }
-      return DACPO_PLY_OK;
-    }
-    if (strcmp(tok[0], "format") == 0) {
-      status = header_format(h, tok, nt, lineno, err, errlen);
-      have_format = 1;
-    }
-    else if (strcmp(tok[0], "element") == 0)
-      status = header_element(h, tok, nt, lineno, err, errlen);
-    else if (strcmp(tok[0], "property") == 0)
-      status = header_property(h, tok, nt, lineno, err, errlen);
-    else {
-      dacpo_support_err(
-          err, errlen, "unknown PLY header keyword '%s' on line %d", tok[0], lineno);
-      status = DACPO_PLY_ERR_FORMAT;
-    }
-    if (status != DACPO_PLY_OK)
-      return status;
-  }
-  dacpo_support_err(
-      err, errlen, "PLY header longer than %d lines", PLY_MAX_HEADER_LINES);
-  return DACPO_PLY_ERR_FORMAT;
 }
 
 /* ------------------------------------------------------------------------- */
@@ -753,7 +532,7 @@ dacpo_ply_open_vertices(const char* path,
     return DACPO_PLY_ERR_MEMORY;
   }
   /* each step runs only if the ones before succeeded */
-  status = read_header(in, h, err, errlen);
+  status = dacpo_ply_parse_header(in, h, path, err, errlen);
   if (status == DACPO_PLY_OK)
     status = find_vertex(h, path, vert, has_normals, err, errlen);
   if (status == DACPO_PLY_OK)

@@ -169,6 +169,69 @@ dacpo_ply_rows_type_name(const dacpo_ply_rows* rows, int k);
 int
 dacpo_ply_rows_set_origin(FILE* f, dacpo_ply_rows* rows, char* err, size_t errlen);
 
+/** \brief Formats of a PLY file (dacpo_ply_header_info.format). */
+enum { DACPO_PLY_ASCII = 0, DACPO_PLY_BINARY_LE = 1, DACPO_PLY_BINARY_BE = 2 };
+
+/** \brief Most elements, and properties per element, a PLY header may declare. */
+#define DACPO_PLY_MAX_ELEMENTS 64
+#define DACPO_PLY_MAX_PROPERTIES 256
+
+/** \brief A property of a PLY element: a scalar, or a list. */
+typedef struct dacpo_ply_property_info {
+  unsigned char bytes;       /**< bytes of the scalar, or of each item of the list */
+  unsigned char count_bytes; /**< bytes of the list's length; 0 for a scalar */
+} dacpo_ply_property_info;
+
+/** \brief An element of a PLY header. */
+typedef struct dacpo_ply_element_info {
+  char name[64];            /**< cut to 63 bytes */
+  unsigned long long count; /**< rows */
+  int nprops;
+  dacpo_ply_property_info props[DACPO_PLY_MAX_PROPERTIES];
+} dacpo_ply_element_info;
+
+/** \brief What a PLY header declares (dacpo_ply_read_header); about 38 kB. */
+typedef struct dacpo_ply_header_info {
+  int format; /**< DACPO_PLY_ASCII, DACPO_PLY_BINARY_LE or DACPO_PLY_BINARY_BE */
+  int nelements;
+  dacpo_ply_element_info elements[DACPO_PLY_MAX_ELEMENTS];
+  unsigned long long data_offset; /**< file offset of the first data byte */
+  int lines; /**< header lines: end_header's line number, or the line of the error */
+} dacpo_ply_header_info;
+
+/**
+ * \brief Read and check the header of a PLY file from \a f (at the file's
+ *  start) through end_header: the one PLY header parser, of dacpo_ply_read()
+ *  and of the pcl_dacpo_* tools' file checks.
+ *
+ * Checked: the first line is "ply"; a format line (ascii, binary_little_endian
+ * or binary_big_endian); every line a comment, obj_info, format, element NAME
+ * COUNT or property line with known types (a list's length an integer type)
+ * without NUL bytes (lines over 4095 bytes are read cut to that); at most
+ * 4096 lines, DACPO_PLY_MAX_ELEMENTS elements and DACPO_PLY_MAX_PROPERTIES
+ * properties each. Not checked: the data.
+ * \param[in] path  named in the message
+ * \return DACPO_PLY_OK with \a f at the first data byte; DACPO_PLY_ERR_FORMAT
+ *  with "'path' is not a valid PLY file: line N: why" (info->lines = N);
+ *  DACPO_PLY_ERR_MEMORY or DACPO_PLY_ERR_IO.
+ */
+int
+dacpo_ply_read_header(
+    FILE* f, const char* path, dacpo_ply_header_info* info, char* err, size_t errlen);
+
+/**
+ * \brief The size a binary PLY file must have: its header and the rows of
+ *  every element, rows with lists walked length by length (what a check of a
+ *  written file compares with the file's size).
+ * \return DACPO_PLY_OK with *bytes; DACPO_PLY_ERR_FORMAT (ASCII, a bad header,
+ *  lists that run past the end) or DACPO_PLY_ERR_IO, *bytes = 0.
+ */
+int
+dacpo_ply_binary_size(const char* path,
+                      unsigned long long* bytes,
+                      char* err,
+                      size_t errlen);
+
 /** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
 void
 dacpo_ply_cloud_free(dacpo_ply_cloud* cloud);

@@ -1,16 +1,18 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Private to the PLY reader (dacpo_ply.c, dacpo_ply_rows.c): the buffered
- * input, the header model and the helpers both files use. Not part of
- * dacpo_ply.h. */
+/* Private to the PLY reader (dacpo_ply.c, dacpo_ply_header.c,
+ * dacpo_ply_rows.c): the buffered input, the header model and the helpers
+ * these files share. Not part of dacpo_ply.h. */
 #ifndef DACPO_PLY_INTERNAL_H
 #define DACPO_PLY_INTERNAL_H
+
+#include "dacpo_ply.h"
 
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 
-#define PLY_MAX_ELEMENTS 64
-#define PLY_MAX_PROPS 128
+#define PLY_MAX_ELEMENTS DACPO_PLY_MAX_ELEMENTS
+#define PLY_MAX_PROPS DACPO_PLY_MAX_PROPERTIES
 #define PLY_BUF_SIZE 65536
 
 /* ------------------------------------------------------------------------- */
@@ -59,6 +61,7 @@ typedef struct ply_header {
   int format;
   ply_element* el; /* PLY_MAX_ELEMENTS */
   int nel;
+  int lines; /* header lines read: end_header's line, or the line of an error */
 } ply_header;
 
 /* Bytes of one value of type t (0 for T_NONE). */
@@ -72,6 +75,18 @@ dacpo_ply_exact_in_float(ply_type t);
 /* Decode one binary value of type t at p (swap = file is big-endian). */
 double
 dacpo_ply_decode(const unsigned char* p, ply_type t, int swap);
+
+/* One header line without its terminator ("\n" or "\r\n"; none for the last
+ * line of the file) from in, cut to cap - 1 bytes: 0, -1 at the end of the
+ * file, -3 when it holds a NUL byte. */
+int
+dacpo_ply_in_line(ply_in* in, char* line, size_t cap);
+
+/* The header from the start of in through end_header into h (h->el holds
+ * PLY_MAX_ELEMENTS); errors name path and the line (dacpo_ply_header.c). */
+int
+dacpo_ply_parse_header(
+    ply_in* in, ply_header* h, const char* path, char* err, size_t errlen);
 
 /* Opens path and reads up to its first vertex row (see dacpo_ply.c); release
  * with dacpo_ply_close() whatever it returns. */

@@ -14,3 +14,26 @@ dacpo_support_err(char* err, size_t errlen, const char* fmt, ...)
   vsnprintf(err, errlen, fmt, ap);
   va_end(ap);
 }
+
+void
+dacpo_support_file_err(char* err,
+                       size_t errlen,
+                       const char* path,
+                       const char* kind,
+                       long line,
+                       const char* fmt,
+                       ...)
+{
+  char what[512];
+  va_list ap;
+  if (!err || errlen == 0)
+    return;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof(what), fmt, ap);
+  va_end(ap);
+  for (char* c = what; *c; ++c)
+    if ((unsigned char)*c < 32 || (unsigned char)*c > 126)
+      *c = '?';
+  snprintf(
+      err, errlen, "'%s' is not a valid %s file: line %ld: %s", path, kind, line, what);
+}

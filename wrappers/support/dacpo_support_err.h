@@ -13,4 +13,19 @@ __attribute__((format(printf, 3, 4)))
 void
 dacpo_support_err(char* err, size_t errlen, const char* fmt, ...);
 
+/* The error of a file that breaks its format, the same for every reader and
+ * check: "'path' is not a valid KIND file: line N: what", the what's bytes
+ * outside printable ASCII shown as '?'. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 6, 7)))
+#endif
+void
+dacpo_support_file_err(char* err,
+                       size_t errlen,
+                       const char* path,
+                       const char* kind,
+                       long line,
+                       const char* fmt,
+                       ...);
+
 #endif /* DACPO_SUPPORT_ERR_H */
