@@ -113,6 +113,9 @@ dacpo_scene_params_init(dacpo_scene_params* params)
   params->fused_views = 0;
   params->fused_shift = 0.01;
   params->fused_angle = 0.2;
+  params->views = 0;
+  params->view_shift = 0.01;
+  params->view_angle = 0.2;
 }
 
 void
@@ -171,14 +174,18 @@ apportion(const double* area, size_t count, size_t n, size_t* out, quota_item* i
 }
 
 /* Keep exactly k of the n points, uniformly, in their original order (Knuth's
- * selection sampling, algorithm S). */
+ * selection sampling, algorithm S). With views (info->views > 0), the views'
+ * first points follow. */
 static void
-downsample(dacpo_scene* s, size_t k, uint64_t seed)
+downsample(dacpo_scene* s, size_t k, uint64_t seed, dacpo_scene_view_info* info)
 {
   dacpo_rng r;
   size_t kept = 0;
+  unsigned view = 0;
   dacpo_rng_seed(&r, seed, STREAM_DOWNSAMPLE);
   for (size_t i = 0; i < s->n && kept < k; ++i) {
+    for (; view < info->views && info->view_start[view] <= i; ++view)
+      info->view_start[view] = kept;
     if ((double)(s->n - i) * dacpo_rng_uniform(&r) < (double)(k - kept)) {
       memmove(s->xyz + 3 * kept, s->xyz + 3 * i, 3 * sizeof(float));
       memmove(s->normals + 3 * kept, s->normals + 3 * i, 3 * sizeof(float));
@@ -187,6 +194,8 @@ downsample(dacpo_scene* s, size_t k, uint64_t seed)
     }
   }
   s->n = kept;
+  for (; view <= info->views && info->views > 0; ++view)
+    info->view_start[view] = kept;
   /* Shrinking; on a failed realloc the larger block stays valid. */
   {
     float* p = (float*)realloc(s->xyz, 3 * kept * sizeof(float));
@@ -300,6 +309,20 @@ check_scene_params(const dacpo_scene_params* params, char* err, size_t errlen)
                       params->fused_angle);
     return SCENE_ERR_INVALID;
   }
+  if (params->views > DACPO_SCENE_MAX_VIEWS ||
+      (params->views > 0 && params->fused_views > 1) || !(params->view_shift >= 0.0) ||
+      !isfinite(params->view_shift) || !(params->view_angle >= 0.0) ||
+      !isfinite(params->view_angle)) {
+    dacpo_support_err(err,
+                      errlen,
+                      "views %u (at most %d, not with fused views), shift %g and angle "
+                      "%g must be finite and >= 0",
+                      params->views,
+                      DACPO_SCENE_MAX_VIEWS,
+                      params->view_shift,
+                      params->view_angle);
+    return SCENE_ERR_INVALID;
+  }
   if (params->downsample_to > n) {
     dacpo_support_err(err,
                       errlen,
@@ -311,8 +334,8 @@ check_scene_params(const dacpo_scene_params* params, char* err, size_t errlen)
   return 0;
 }
 
-/* counts[i] points on patch i, in patch order, from the geometry stream; then
- * the part -> object table and the object names. */
+/* counts[i] points on patch i, in patch order, from the geometry stream (none
+ * when counts is NULL); then the part -> object table and the object names. */
 static void
 sample_patches(const scene_builder* b,
                const size_t* counts,
@@ -322,7 +345,7 @@ sample_patches(const scene_builder* b,
   dacpo_rng r;
   size_t next = 0;
   dacpo_rng_seed(&r, seed, STREAM_GEOMETRY);
-  for (size_t i = 0; i < b->count; ++i) {
+  for (size_t i = 0; i < b->count && counts; ++i) {
     for (size_t j = 0; j < counts[i]; ++j, ++next) {
       double pos[3] = {0.0, 0.0, 0.0}, nrm[3] = {0.0, 0.0, 1.0}, len;
       dacpo_scene_prim_sample(&b->prims[i], &r, pos, nrm);
@@ -343,12 +366,57 @@ sample_patches(const scene_builder* b,
     s->object_name[i] = b->names[i];
 }
 
+/* The points of the scene into s (allocated for target_points): uniform by
+ * area or seen by the cameras, then downsampled, fused and noisy as asked. The
+ * scratch arrays have one slot per patch. Returns 0, or -1 with a message. */
+static int
+fill_points(const scene_builder* b,
+            const dacpo_scene_params* params,
+            dacpo_scene* s,
+            dacpo_scene_view_info* info,
+            double* area,
+            size_t* counts,
+            quota_item* items,
+            char* err,
+            size_t errlen)
+{
+  if (params->views > 0) {
+    sample_patches(b, NULL, params->seed, s); /* the part and object tables */
+    if (dacpo_scene_sample_views(b, params, s, info, err, errlen) != 0)
+      return SCENE_ERR_INVALID;
+  }
+  else {
+    for (size_t i = 0; i < b->count; ++i)
+      area[i] = dacpo_scene_prim_area(&b->prims[i]);
+    apportion(area, b->count, params->target_points, counts, items);
+    sample_patches(b, counts, params->seed, s);
+  }
+  if (params->downsample_to > 0 && params->downsample_to < s->n)
+    downsample(s, params->downsample_to, params->seed, info);
+  if (params->fused_views > 1)
+    fuse_views(s, params->fused_views, params->fused_shift, params->fused_angle, params->seed);
+  if (params->noise_sigma > 0.0)
+    add_noise(s, params->noise_sigma, params->seed);
+  return 0;
+}
+
 int
 dacpo_scene_generate(const dacpo_scene_params* params,
                      dacpo_scene* out,
                      char* err,
                      size_t errlen)
 {
+  return dacpo_scene_generate_views(params, out, NULL, err, errlen);
+}
+
+int
+dacpo_scene_generate_views(const dacpo_scene_params* params,
+                           dacpo_scene* out,
+                           dacpo_scene_view_info* info,
+                           char* err,
+                           size_t errlen)
+{
+  dacpo_scene_view_info spare;
   scene_builder b;
   double* area = NULL;
   size_t* counts = NULL;
@@ -361,6 +429,9 @@ dacpo_scene_generate(const dacpo_scene_params* params,
     err[0] = '\0';
   if (out)
     memset(out, 0, sizeof(*out));
+  if (!info)
+    info = &spare;
+  memset(info, 0, sizeof(*info));
   if (!params || !out) {
     dacpo_support_err(
         err, errlen, "dacpo_scene_generate: %s is NULL", !params ? "params" : "out");
@@ -397,16 +468,8 @@ dacpo_scene_generate(const dacpo_scene_params* params,
       !s.object_name)
     goto oom;
 
-  for (size_t i = 0; i < b.count; ++i)
-    area[i] = dacpo_scene_prim_area(&b.prims[i]);
-  apportion(area, b.count, n, counts, items);
-  sample_patches(&b, counts, params->seed, &s);
-  if (params->downsample_to > 0 && params->downsample_to < s.n)
-    downsample(&s, params->downsample_to, params->seed);
-  if (params->fused_views > 1)
-    fuse_views(&s, params->fused_views, params->fused_shift, params->fused_angle, params->seed);
-  if (params->noise_sigma > 0.0)
-    add_noise(&s, params->noise_sigma, params->seed);
+  if ((status = fill_points(&b, params, &s, info, area, counts, items, err, errlen)) != 0)
+    goto done;
 
   *out = s;
   memset(&s, 0, sizeof(s));

@@ -88,6 +88,9 @@ typedef enum dacpo_scene_kind {
 /** \brief Most views dacpo_scene_params::fused_views takes. */
 #define DACPO_SCENE_MAX_FUSED_VIEWS 16
 
+/** \brief Most depth-camera views dacpo_scene_params::views takes. */
+#define DACPO_SCENE_MAX_VIEWS 64
+
 /** \brief Generation parameters; fill with dacpo_scene_params_init() first. */
 typedef struct dacpo_scene_params {
   unsigned kind;        /**< a ::dacpo_scene_kind; default DACPO_SCENE_ROOM */
@@ -106,7 +109,30 @@ typedef struct dacpo_scene_params {
                              length in a random direction); default 0.01 */
   double fused_angle;   /**< the error's rotation about the scene's centre,
                              degrees (random axis); default 0.2 */
+  unsigned views;       /**< depth-camera views (like registered RGB-D frames
+                             concatenated): each of `views` cameras (60 x 45
+                             degrees, 0.3..6 m) keeps only the surface it sees,
+                             unoccluded, with a density falling as cos/r^2; the
+                             points come view by view, each view's share of
+                             target_points, and each view but the first is
+                             moved by its own pose error (below); normals face
+                             their own camera; 0 = none (uniform sampling);
+                             not with fused_views > 1; default 0 */
+  double view_shift;    /**< pose error translation, metres (random direction);
+                             default 0.01 */
+  double view_angle;    /**< pose error rotation about a random axis through the
+                             camera, degrees; default 0.2 */
 } dacpo_scene_params;
+
+/** \brief The cameras of a scene generated with views (see
+ *  dacpo_scene_generate_views). */
+typedef struct dacpo_scene_view_info {
+  unsigned views;   /**< number of views (0 when the scene has none) */
+  size_t view_start[DACPO_SCENE_MAX_VIEWS + 1]; /**< view v's points are
+                             [view_start[v], view_start[v + 1]) */
+  double eye[DACPO_SCENE_MAX_VIEWS][3];    /**< camera centre (no pose error) */
+  double target[DACPO_SCENE_MAX_VIEWS][3]; /**< the point it looks at */
+} dacpo_scene_view_info;
 
 /** \brief A generated scene. All arrays are owned; free with dacpo_scene_free(). */
 typedef struct dacpo_scene {
@@ -140,15 +166,27 @@ dacpo_scene_params_init(dacpo_scene_params* params);
  * \param[in]  errlen  size of err
  * \return 0 on success; -1 for invalid arguments (NULL pointer, unknown kind,
  *         target_points == 0, negative or non-finite noise, downsample_to >
- *         target_points, negative or non-finite fused_shift / fused_angle),
- *         -2 when out of memory.
- * Cost: O(target_points) time and memory (28 bytes per point).
+ *         target_points, negative or non-finite fused_shift / fused_angle /
+ *         view_shift / view_angle, views > DACPO_SCENE_MAX_VIEWS, views with
+ *         fused_views > 1, or no camera place found), -2 when out of memory.
+ * Cost: O(target_points) time and memory (28 bytes per point); with views,
+ *       O(target_points * patches) ray casts.
  */
 int
 dacpo_scene_generate(const dacpo_scene_params* params,
                      dacpo_scene* out,
                      char* err,
                      size_t errlen);
+
+/** \brief dacpo_scene_generate() that also reports the cameras (when
+ *  params->views > 0) in \a info (may be NULL; zeroed first). view_start
+ *  follows downsampling. */
+int
+dacpo_scene_generate_views(const dacpo_scene_params* params,
+                           dacpo_scene* out,
+                           dacpo_scene_view_info* info,
+                           char* err,
+                           size_t errlen);
 
 /** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
 void

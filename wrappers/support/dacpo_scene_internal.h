@@ -70,6 +70,18 @@ dacpo_scene_prim_sample(const scene_prim* p,
                         double pos[3],
                         double nrm[3]);
 
+/* Depth-camera views (dacpo_scene_views.c): params->target_points points of
+ * the patches of b, view by view, into s (xyz, normals, part; s->n set),
+ * cameras into info. Returns 0, or -1 with a message when no camera place is
+ * found or a view sees too little. */
+int
+dacpo_scene_sample_views(const scene_builder* b,
+                         const dacpo_scene_params* params,
+                         dacpo_scene* s,
+                         dacpo_scene_view_info* info,
+                         char* err,
+                         size_t errlen);
+
 /* Name and builder of each scene kind, indexed by dacpo_scene_kind. */
 extern const scene_entry dacpo_scene_table[DACPO_SCENE_KIND_COUNT];
 

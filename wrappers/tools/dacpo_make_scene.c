@@ -4,7 +4,8 @@
  * little-endian PLY (float x y z nx ny nz). Plain C, needs only dacpo_support.
  *
  *   dacpo_make_scene out.ply [-scene room] [-n 100000] [-noise 0] [-downsample 0]
- *                            [-fused V,SHIFT,DEG] [-seed 1] [-offset X,Y,Z] [-scale S]
+ *                            [-fused V,SHIFT,DEG] [-views V,SHIFT,DEG] [-seed 1]
+ *                            [-offset X,Y,Z] [-scale S]
  *
  * -offset moves the scene and -scale scales it (x S, then + offset); both write
  * double x y z (georeferenced scans: in float, an offset of 5e6 m leaves a
@@ -83,6 +84,13 @@ print_help(const char* prog)
          "                   by SHIFT metres and turned by DEG degrees (random\n"
          "                   directions), so surfaces come as offset copies, e.g.\n"
          "                   3,0.008,0.2 (default: none)\n");
+  printf("  -views V,SHIFT,DEG  V depth-camera views (60x45 deg, 0.3-6 m) like registered\n"
+         "                   RGB-D frames concatenated: each camera keeps the surface it\n"
+         "                   sees unoccluded (density ~ cos/range^2), view by view, each\n"
+         "                   view but the first moved by SHIFT metres and turned by DEG\n"
+         "                   degrees about its camera (random directions); normals face\n"
+         "                   their camera, e.g. 20,0.02,0.5 (V <= %d; default: none)\n",
+         DACPO_SCENE_MAX_VIEWS);
   printf("  -seed S          random seed (default: %llu)\n",
          (unsigned long long)d.seed);
   printf("  -offset X,Y,Z    add this offset and write double x y z (as georeferenced\n"
@@ -167,7 +175,7 @@ apply_option(const char* prog, const char* a, const char* v, make_options* o)
   dacpo_scene_params* p = &o->p;
   if (strcmp(a, "-scene") && strcmp(a, "-n") && strcmp(a, "-noise") &&
       strcmp(a, "-downsample") && strcmp(a, "-seed") && strcmp(a, "-offset") &&
-      strcmp(a, "-scale") && strcmp(a, "-fused"))
+      strcmp(a, "-scale") && strcmp(a, "-fused") && strcmp(a, "-views"))
     return usage_error(prog, "unknown option", a);
   if (!v)
     return usage_error(prog, "missing value after", a);
@@ -199,6 +207,14 @@ apply_option(const char* prog, const char* a, const char* v, make_options* o)
         !(p->fused_shift >= 0.0) || !isfinite(p->fused_angle) || !(p->fused_angle >= 0.0))
       return usage_error(
           prog, "-fused needs V,SHIFT,DEG (V <= 16, SHIFT and DEG finite >= 0), got", v);
+  }
+  else if (strcmp(a, "-views") == 0) {
+    char tail = 0;
+    if (sscanf(v, "%u,%lf,%lf%c", &p->views, &p->view_shift, &p->view_angle, &tail) != 3 ||
+        p->views < 1 || p->views > DACPO_SCENE_MAX_VIEWS || !isfinite(p->view_shift) ||
+        !(p->view_shift >= 0.0) || !isfinite(p->view_angle) || !(p->view_angle >= 0.0))
+      return usage_error(
+          prog, "-views needs V,SHIFT,DEG (1 <= V <= 64, SHIFT and DEG finite >= 0), got", v);
   }
   else if (strcmp(a, "-offset") == 0) {
     char tail = 0;
@@ -250,6 +266,8 @@ parse_args(int argc, char** argv, const char* prog, make_options* o)
   if (!ply && o->use_offset)
     return usage_error(prog, "-offset / -scale write double x y z: use a .ply name, not",
                        o->out_path);
+  if (o->p.views > 0 && o->p.fused_views > 1)
+    return usage_error(prog, "-views and -fused exclude each other", NULL);
   if (o->p.downsample_to > o->p.target_points) {
     fprintf(stderr,
             "%s: -downsample %zu is larger than -n %zu\n",
