@@ -232,6 +232,14 @@ dacpo_ply_binary_size(const char* path,
                       char* err,
                       size_t errlen);
 
+/**
+ * \brief The value at \a p of the PLY scalar type called \a type_name (char,
+ *  uchar, int8 ... float64, as in a header), its bytes little-endian or, with
+ *  \a big_endian, big-endian; 0 for a name that is no PLY type.
+ */
+double
+dacpo_ply_decode_named(const unsigned char* p, const char* type_name, int big_endian);
+
 /** \brief Free the arrays and zero the struct. NULL-safe, idempotent. */
 void
 dacpo_ply_cloud_free(dacpo_ply_cloud* cloud);

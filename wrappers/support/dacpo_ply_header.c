@@ -55,6 +55,13 @@ parse_type(const char* s)
   return T_NONE;
 }
 
+double
+dacpo_ply_decode_named(const unsigned char* p, const char* type_name, int big_endian)
+{
+  const ply_type t = parse_type(type_name);
+  return t == T_NONE ? 0.0 : dacpo_ply_decode(p, t, big_endian != 0);
+}
+
 static int
 prop_role(const char* name)
 {

@@ -76,6 +76,20 @@ dacpo_scene_rng_unit_vector(dacpo_rng* r, double d[3])
   d[2] = z;
 }
 
+/* Rodrigues: rot = I + sin(th) K + (1 - cos(th)) K^2, K the cross matrix of a. */
+void
+dacpo_scene_rotation(const double a[3], double th, double rot[9])
+{
+  const double K[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double k2 = 0.0;
+      for (int m = 0; m < 3; ++m)
+        k2 += K[3 * i + m] * K[3 * m + j];
+      rot[3 * i + j] = (i == j) + sin(th) * K[3 * i + j] + (1.0 - cos(th)) * k2;
+    }
+}
+
 /* ------------------------------------------------------------------------- */
 /* Public functions.                                                          */
 
@@ -246,16 +260,7 @@ fuse_views(dacpo_scene* s, unsigned views, double shift, double angle_deg, uint6
     double a[3], t[3];
     dacpo_scene_rng_unit_vector(&r, a);
     dacpo_scene_rng_unit_vector(&r, t);
-    /* Rodrigues: R = I + sin(th) K + (1 - cos(th)) K^2, K the cross matrix of a */
-    const double th = v == 0 ? 0.0 : angle_deg * (3.14159265358979323846 / 180.0);
-    const double K[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        double k2 = 0.0;
-        for (int m = 0; m < 3; ++m)
-          k2 += K[3 * i + m] * K[3 * m + j];
-        rot[v][3 * i + j] = (i == j) + sin(th) * K[3 * i + j] + (1.0 - cos(th)) * k2;
-      }
+    dacpo_scene_rotation(a, v == 0 ? 0.0 : angle_deg * (3.14159265358979323846 / 180.0), rot[v]);
     for (int k = 0; k < 3; ++k)
       move[v][k] = v == 0 ? 0.0 : shift * t[k];
   }

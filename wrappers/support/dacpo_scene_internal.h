@@ -54,6 +54,9 @@ typedef struct scene_entry {
 /* Uniform unit vector (dacpo_scene.c, next to the Gaussian). */
 void
 dacpo_scene_rng_unit_vector(dacpo_rng* r, double d[3]);
+/* The rotation by th radians about the unit axis a (Rodrigues), row-major. */
+void
+dacpo_scene_rotation(const double a[3], double th, double rot[9]);
 
 /* Euclidean length of a 3-vector. */
 double

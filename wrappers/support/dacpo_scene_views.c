@@ -311,20 +311,6 @@ place_eye(const view_ctx* cx, unsigned kind, dacpo_rng* r, double eye[3])
   return -1;
 }
 
-/* Rodrigues: rot = I + sin(th) K + (1 - cos(th)) K^2, K the cross matrix of a. */
-static void
-rotation(const double a[3], double th, double rot[9])
-{
-  const double K[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      double k2 = 0.0;
-      for (int m = 0; m < 3; ++m)
-        k2 += K[3 * i + m] * K[3 * m + j];
-      rot[3 * i + j] = (i == j) + sin(th) * K[3 * i + j] + (1.0 - cos(th)) * k2;
-    }
-}
-
 /* Camera v: place, a target 1..5 m away (objects: any surface point), the
  * frame, the pose error (none for view 0). */
 static int
@@ -354,7 +340,7 @@ make_camera(const view_ctx* cx, const dacpo_scene_params* prm, unsigned v, dacpo
   cross3(cam->right, cam->fwd, cam->up);
   dacpo_scene_rng_unit_vector(r, axis);
   dacpo_scene_rng_unit_vector(r, dir);
-  rotation(axis, v == 0 ? 0.0 : prm->view_angle * (SCENE_PI / 180.0), cam->rot);
+  dacpo_scene_rotation(axis, v == 0 ? 0.0 : prm->view_angle * (SCENE_PI / 180.0), cam->rot);
   for (int k = 0; k < 3; ++k)
     cam->move[k] = v == 0 ? 0.0 : prm->view_shift * dir[k];
   return 0;

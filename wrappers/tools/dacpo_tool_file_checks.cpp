@@ -644,39 +644,6 @@ checkPlyAscii(std::FILE* f,
   return true;
 }
 
-/** A binary value of PLY type \a type (a name the header parser took; an
- *  unknown one reads as uint8) at \a b, in the file's byte order. */
-double
-binaryValue(const unsigned char* b, const std::string& type, bool big)
-{
-  static const char* const names[] = {"char",  "int8",    "uchar",  "uint8",
-                                      "short", "int16",   "ushort", "uint16",
-                                      "int",   "int32",   "uint",   "uint32",
-                                      "float", "float32", "double", "float64"};
-  int k = 1; /* 0 int8, 1 uint8, 2 int16, 3 uint16, 4 int32, 5 uint32, 6, 7 */
-  for (int i = 0; i < 16; ++i)
-    if (type == names[i])
-      k = i / 2;
-  const int bytes = k < 2 ? 1 : k < 4 ? 2 : k < 7 ? 4 : 8;
-  std::uint64_t u = 0;
-  for (int i = 0; i < bytes; ++i)
-    u |= static_cast<std::uint64_t>(b[i]) << (8 * (big ? bytes - 1 - i : i));
-  float f32 = 0;
-  double f64 = 0;
-  const auto u32 = static_cast<std::uint32_t>(u);
-  std::memcpy(&f32, &u32, 4);
-  std::memcpy(&f64, &u, 8);
-  const double as[] = {static_cast<double>(static_cast<std::int8_t>(u)),
-                       static_cast<double>(u),
-                       static_cast<double>(static_cast<std::int16_t>(u)),
-                       static_cast<double>(u),
-                       static_cast<double>(static_cast<std::int32_t>(u)),
-                       static_cast<double>(u),
-                       f32,
-                       f64};
-  return as[k];
-}
-
 /** One binary row of \a e (\a f at it): its lists to \a pcl, row \a r. False
  *  with the message when PCL's reader would fail on them; \a end: the data
  *  ends early (left to the reader, which fails cleanly). */
@@ -697,11 +664,11 @@ checkPlyRowBinary(std::FILE* f,
     double item = 0;
     end = cb != 0 && std::fread(b, 1, cb, f) != cb;
     if (cb != 0 && !end)
-      n = static_cast<unsigned long long>(binaryValue(b, lengths[cb], big));
+      n = static_cast<unsigned long long>(dacpo_ply_decode_named(b, lengths[cb], big));
     const bool first = cb != 0 && n > 0 && pcl.wantsItem(j) && !end;
     end = end || (first && std::fread(b, 1, p.bytes, f) != p.bytes);
     if (first && !end)
-      item = binaryValue(b, pcl.rule.grid_item, big);
+      item = dacpo_ply_decode_named(b, pcl.rule.grid_item.c_str(), big);
     if (!end && cb != 0 && !pcl.list(r, j, n, item))
       return false;
     const unsigned long long skip = (first ? n - 1 : n) * p.bytes;
