@@ -69,9 +69,12 @@ def keywords():
     return "\n".join(out) + "\n"
 
 
+def block_text(who):
+    """What goes between the markers of a block for \a who."""
+    return keywords() if who == "KEYWORDS" else markdown(who) + "\n"
+
+
 def markdown(who):
-    if who == "KEYWORDS":
-        return keywords()
     out = [f"**{TITLES[who]}**", "", "| field | CLI | default | range | contract |",
            "|---|---|---|---|---|"]
     for kind, name, value, lo, hi, audience, cli, flag, doc in rows():
@@ -91,8 +94,7 @@ def filled(path):
         e = END.search(text, m.end())
         if not e:
             sys.exit(f"param_table: {path}: no end marker after {m.group(0)}")
-        table = markdown(m.group(1))
-        out += [text[pos:m.end()], "\n" + (table if m.group(1) == "KEYWORDS" else table + "\n")]
+        out += [text[pos:m.end()], "\n" + block_text(m.group(1))]
         pos, blocks = e.start(), blocks + 1
     if not blocks:
         sys.exit(f"param_table: {path} has no scripts/param_table.py block")
