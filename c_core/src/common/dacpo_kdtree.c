@@ -261,15 +261,19 @@ kd_search(const dacpo_kdtree* t, const double q[3], kd_result* r)
     }
     const dacpo_tree_point* p = t->pts + nd->begin;
     uint32_t m = nd->end - nd->begin;
+    /* distances first (a branch-free loop the compiler vectorises), then the
+     * few that may enter the answer */
+    double dd[KD_LEAF];
+    for (uint32_t i = 0; i < m; ++i) {
+      const double dx = q0 - p[i].x[0], dy = q1 - p[i].x[1], dz = q2 - p[i].x[2];
+      dd[i] = dx * dx + dy * dy + dz * dz;
+    }
     double worst = r->d[r->k - 1];
-    for (uint32_t i = 0; i < m; ++i, ++p) {
-      double dx = q0 - p->x[0], dy = q1 - p->x[1], dz = q2 - p->x[2];
-      double d = dx * dx + dy * dy + dz * dz;
-      if (d <= worst) {
-        kd_push(r, d, p->id);
+    for (uint32_t i = 0; i < m; ++i)
+      if (dd[i] <= worst) {
+        kd_push(r, dd[i], p[i].id);
         worst = r->d[r->k - 1];
       }
-    }
     /* resume at the deepest pending subtree that may still hold a closer point */
     for (;;) {
       if (top == 0)

@@ -60,11 +60,14 @@ dacpo_rng_uniform(dacpo_rng* rng)
   return (double)(dacpo_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
 }
 
-/* Uniform integer in [0, n), n > 0. */
+/* Uniform integer in [0, n), n > 0. u * n can round up to n, which gives 0
+ * (the value (u * n) % n gives, without a division: stage 2's shuffles draw
+ * about one number per neighbour per point and order). */
 static inline size_t
 dacpo_rng_below(dacpo_rng* rng, size_t n)
 {
-  return (size_t)(dacpo_rng_uniform(rng) * (double)n) % n;
+  const size_t r = (size_t)(dacpo_rng_uniform(rng) * (double)n);
+  return r < n ? r : 0;
 }
 
 #endif /* DACPO_RNG_H */
