@@ -227,7 +227,8 @@ estimate_spacing(
   double* tmp = (double*)dacpo_malloc_array(n, sizeof(double));
   if (!tmp)
     return DACPO_OOM(err);
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t pos = 0; pos < n; ++pos) { /* tree order: the tree stays in cache */
+    const size_t i = (size_t)dacpo_kdtree_order_at(w->tree, pos);
     w->area[i] = dacpo_kdtree_sample_area(w->tree, xyz + 3 * i);
     tmp[i] = w->area[i];
   }
@@ -556,17 +557,31 @@ ipsr_vote(ipsr_work* w,
   }
 }
 
-/* One surface from the current normals: Poisson solve, iso-surface, each
- * face's nearest samples, and the wings trimmed if trimming (else every face
- * kept). t[0..2]: the clock before the solve, after it, after the extraction. */
+/* Sizes of one block's iterations, and their last surface. */
+typedef struct ipsr_run {
+  size_t n;     /* samples */
+  size_t k;     /* nearest samples a face votes for */
+  size_t top_m; /* changes averaged by the convergence test */
+  double far2;  /* squared trimming distance */
+  int want_mesh;
+  const dacpo_mesh* mesh; /* the last surface (points into the extractor) */
+  int mesh_trimmed;       /* its wings were trimmed */
+  int same;               /* the last solve left chi as it was: same surface */
+} ipsr_run;
+
+/* One surface from the current normals: Poisson solve, iso-surface
+ * (run->mesh), each face's nearest samples, and the wings trimmed if trimming
+ * (else every face kept). A solve that takes no CG step (the new normals moved
+ * the right-hand side by less than the tolerance) leaves chi, hence the
+ * surface, as it was: with the same trimming its votes would give the current
+ * normals again, so run->same is set and nothing is extracted. t[0..2]: the
+ * clock before the solve, after it, after the extraction. */
 static dacpo_status
 ipsr_surface(ipsr_work* w,
              const double* nrm,
-             size_t k,
              int trimming,
-             double far2,
              const dacpo_ipsr_params* params,
-             const dacpo_mesh** mesh,
+             ipsr_run* run,
              double* t,
              dacpo_ipsr_stats* st,
              dacpo_err* err)
@@ -575,23 +590,27 @@ ipsr_surface(ipsr_work* w,
   dacpo_poisson_info info;
   DACPO_TRY(dacpo_poisson_solve(w->ps, nrm, &info, err));
   st->cg_iterations += info.iterations;
-  t[1] = dacpo_now();
+  t[1] = t[2] = dacpo_now();
+  run->same = run->mesh != NULL && info.iterations == 0 && run->mesh_trimmed == trimming;
+  if (run->same)
+    return DACPO_OK;
   DACPO_TRY(dacpo_mcubes_extract(w->mc,
                                  dacpo_poisson_grid(w->ps),
                                  dacpo_poisson_values(w->ps),
                                  dacpo_poisson_domain(w->ps),
                                  info.iso_value,
-                                 mesh,
+                                 &run->mesh,
                                  err));
   t[2] = dacpo_now();
-  if (!ensure_faces(w, (*mesh)->num_triangles, k) ||
-      !ensure_vertices(w, (*mesh)->num_vertices))
+  const dacpo_mesh* mesh = run->mesh;
+  if (!ensure_faces(w, mesh->num_triangles, run->k) ||
+      !ensure_vertices(w, mesh->num_vertices))
     return DACPO_OOM(err);
-  query_faces(w, *mesh, k);
+  query_faces(w, mesh, run->k);
   if (trimming)
-    trim_faces(w, *mesh, far2, params->experiment.trim_interior);
+    trim_faces(w, mesh, run->far2, params->experiment.trim_interior);
   else
-    memset(w->removed, 0, (*mesh)->num_triangles);
+    memset(w->removed, 0, mesh->num_triangles);
   return DACPO_OK;
 }
 
@@ -615,17 +634,6 @@ ipsr_iteration_stats(const ipsr_work* w,
     st->peak_bytes = b;
 }
 
-/* Sizes of one block's iterations, and their last surface. */
-typedef struct ipsr_run {
-  size_t n;     /* samples */
-  size_t k;     /* nearest samples a face votes for */
-  size_t top_m; /* changes averaged by the convergence test */
-  double far2;  /* squared trimming distance */
-  int want_mesh;
-  const dacpo_mesh* mesh; /* the last surface (points into the extractor) */
-  int mesh_trimmed;       /* its wings were trimmed */
-} ipsr_run;
-
 /* The iterations: surface, vote, convergence test. With max_iterations == 0
  * the body still runs once without updating the normals, to give the mesh
  * (if wanted). old: 3n scratch. */
@@ -645,12 +653,14 @@ ipsr_iterate(ipsr_work* w,
     if (it >= params->trim_start)
       trimming = 1;
     double t[4];
-    DACPO_TRY(
-        ipsr_surface(w, nrm, k, trimming, run->far2, params, &run->mesh, t, st, err));
+    DACPO_TRY(ipsr_surface(w, nrm, trimming, params, run, t, st, err));
     run->mesh_trimmed = trimming;
     if (iters == 0)
       break;
-    ipsr_vote(w, run->mesh, k, params->fixed, nrm, old, n);
+    if (run->same)
+      memset(w->change, 0, n * sizeof(double)); /* the vote would repeat nrm */
+    else
+      ipsr_vote(w, run->mesh, k, params->fixed, nrm, old, n);
     t[3] = dacpo_now();
     ipsr_iteration_stats(w, run->mesh, k, it, t, st);
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);
