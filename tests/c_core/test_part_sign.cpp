@@ -221,6 +221,66 @@ TEST(PartSign, SlabPartsSayWhichWayIsOut)
   EXPECT_EQ(outward[5], 0) << "the wall the other way round: still one face";
 }
 
+// A room scanned from inside (floor and four walls, 6 x 5 x 2.6 m: the
+// largest part) and a table in it (a 1.6 x 0.9 m top at 0.75 m, four legs of
+// 3 cm radius seen from all round) as a part of its own, handed over inside
+// out (top facing down, legs facing in) or right. One viewpoint under the top
+// explains every point of the inside-out table, one above it only the right
+// table's top and the near sides of its legs; a scan is seen from the room's
+// free space, outside its objects, so the table must come out facing up
+// either way. Known failure (2026-12-05): the viewpoint found is (1.88, 2.55,
+// 0.10), beside the table below its top, and the table comes out inside out
+// both ways; keeping the viewpoint out of the smaller parts' boxes does not
+// change that here (docs/DESIGN.md, known limits). Enable when it holds.
+TEST(PartSign, DISABLED_AnObjectInsideTheRoomIsNotSeenFromItsInside)
+{
+  Shapes s;
+  const double X = 6.0, Y = 5.0, H = 2.6, step = 0.05;
+  for (double x = 0.0; x <= X; x += step)
+    for (double y = 0.0; y <= Y; y += step)
+      s.add(x, y, 0.0, 0.0, 0.0, 1.0, 0); // floor
+  for (double z = step; z <= H; z += step) {
+    for (double x = 0.0; x <= X; x += step) {
+      s.add(x, 0.0, z, 0.0, 1.0, 0.0, 0);
+      s.add(x, Y, z, 0.0, -1.0, 0.0, 0);
+    }
+    for (double y = 0.0; y <= Y; y += step) {
+      s.add(0.0, y, z, 1.0, 0.0, 0.0, 0);
+      s.add(X, y, z, -1.0, 0.0, 0.0, 0);
+    }
+  }
+  const size_t room = s.part.size();
+  for (double x = 2.2; x <= 3.8; x += 0.02)
+    for (double y = 1.75; y <= 2.65; y += 0.02)
+      s.add(x, y, 0.75, 0.0, 0.0, 1.0, 1); // top
+  const double kPi = 3.14159265358979323846;
+  for (double cx : {2.3, 3.7})
+    for (double cy : {1.85, 2.55})
+      for (double z = 0.05; z < 0.73; z += 0.02)
+        for (int a = 0; a < 12; ++a) {
+          const double c = std::cos(2.0 * kPi * a / 12), d = std::sin(2.0 * kPi * a / 12);
+          s.add(cx + 0.03 * c, cy + 0.03 * d, z, c, d, 0.0, 1); // legs, outward
+        }
+  const size_t n = s.part.size();
+  for (double given : {-1.0, 1.0}) {
+    SCOPED_TRACE(given < 0.0 ? "table handed over inside out" : "table handed over right");
+    std::vector<double> nrm = s.nrm;
+    for (size_t i = room; i < n; ++i)
+      for (int d = 0; d < 3; ++d)
+        nrm[3 * i + d] *= given;
+    int8_t sign[2] = {0, 0};
+    double conf[2] = {0.0, 0.0}, score = 0.0;
+    dacpo_err err = {DACPO_OK, {0}};
+    ASSERT_EQ(dacpo_part_signs(
+                  s.xyz.data(), nrm.data(), n, s.part.data(), 2, sign, conf, &score, &err),
+              DACPO_OK)
+        << err.msg;
+    EXPECT_EQ(sign[0], 1) << "the largest part keeps its sign";
+    EXPECT_EQ(sign[1] * given, 1.0) << "the table faces up";
+    EXPECT_GT(conf[1], 0.5);
+  }
+}
+
 TEST(PartSign, ClosedPartsRefuseNullInput)
 {
   int8_t outward[2] = {5, 5};
