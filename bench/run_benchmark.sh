@@ -355,10 +355,11 @@ def gen_scene(name, args):
     path = os.path.join(work, "in", name + ".ply")
     if not os.path.exists(path):
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        r = run_quiet([os.path.join(tools, "dacpo_make_scene"), path + ".tmp"] + args)
+        tmp = path[:-len(".ply")] + ".tmp.ply"  # the generator wants a .ply name
+        r = run_quiet([os.path.join(tools, "dacpo_make_scene"), tmp] + args)
         if r.returncode != 0:
             log(r.stdout); sys.exit(f"run_benchmark: dacpo_make_scene failed for {name}")
-        os.replace(path + ".tmp", path)
+        os.replace(tmp, path)
     return path
 
 
@@ -722,6 +723,24 @@ def scaling_markdown(sc):
         cells += [f"{sg[s]:.2f}" if s in sg else "—" for s in STAGES]
         cells.append(f"{r['wrong_pct']:.2f}" if isinstance(r.get("wrong_pct"), (int, float)) else "—")
         L.append("| " + " | ".join(cells) + " |")
+    L.append("")
+    # the work inside stages 2-3, from the tool's stats line
+    L.append("Work inside stages 2–3 (the tool's stats line): stage-2 restarts run "
+             "(blocks that ran them all; the others stopped after four that agreed), "
+             "stage-3 iterations per block, CG steps, faces queried and voted, and "
+             "iterations whose solve left the surface as it was.\n")
+    head = ["points", "restarts (blocks, all)", "iPSR iterations / block", "CG steps",
+            "faces voted", "surfaces kept"]
+    L.append("| " + " | ".join(head) + " |")
+    L.append("|" + "---:|" * len(head))
+    for r in sc["runs"]:
+        ts = r.get("tool_stats", {})
+        if "restarts" not in ts:
+            continue
+        L.append("| " + " | ".join([
+            fmt_n(r["points"]), f"{ts['restarts']} ({ts.get('blocks', '—')}, {ts.get('blocks_all_restarts', '—')})",
+            f"{ts.get('ipsr_iterations_mean', 0):.2f}", str(ts.get("ipsr_cg_steps", "—")),
+            str(ts.get("ipsr_faces", "—")), str(ts.get("ipsr_reused", "—"))]) + " |")
     L.append("")
     f = sc.get("fit", {})
     if f:

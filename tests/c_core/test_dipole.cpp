@@ -612,3 +612,41 @@ TEST(DacpoDipole, RestartVoteHoldsOnEverySeed)
   EXPECT_GE(lo, 0.85);
   EXPECT_LE(hi - lo, 0.08);
 }
+
+// The restarts run are reported: a clean sphere gives the same signs on every
+// restart, so the block stops after the first four; the shelves' restarts
+// disagree on some seed, and then all of them run; one restart is one.
+TEST(DacpoDipole, ReportsTheRestartsItRan)
+{
+  std::vector<int8_t> sign;
+  size_t ran = 0;
+  dacpo_err err{};
+  auto run = [&](const Shape& s, dacpo_dipole_params p) {
+    sign.assign(s.size(), 0);
+    ran = 0;
+    p.restarts_out = &ran;
+    EXPECT_EQ(
+        dacpo_dipole_orient(s.xyz.data(), s.nrm.data(), s.size(), &p, sign.data(), &err),
+        DACPO_OK)
+        << err.msg;
+  };
+  const Shape ball = sphere(1500, 5);
+  run(ball, pipeline_params());
+  EXPECT_EQ(ran, 4u);
+  EXPECT_EQ(score(ball, sign), 1.0);
+  dacpo_dipole_params one = pipeline_params();
+  one.restarts = 1;
+  run(ball, one);
+  EXPECT_EQ(ran, 1u);
+  const Shape shelves = shelves_on_panel(4, 0.01, 3);
+  size_t most = 0;
+  dacpo_dipole_params p = pipeline_params();
+  p.restarts = 8;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    p.seed = seed;
+    run(shelves, p);
+    EXPECT_TRUE(ran == 4 || ran == 8) << ran;
+    most = std::max(most, ran);
+  }
+  EXPECT_EQ(most, 8u);
+}

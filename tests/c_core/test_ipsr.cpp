@@ -179,6 +179,9 @@ TEST(DacpoIpsr, WavySheetWithFlippedNormalsConverges)
   EXPECT_LT(c.wrong_percent(), 1.0);
   EXPECT_TRUE(r.stats.converged);
   EXPECT_LE(r.stats.iterations, 20u);
+  EXPECT_GE(r.stats.faces_total, r.stats.faces);
+  EXPECT_LE(r.stats.faces_total, r.stats.iterations * r.stats.faces * 2);
+  EXPECT_LT(r.stats.surfaces_reused, r.stats.iterations);
   EXPECT_LE(r.stats.peak_bytes, (size_t)64 << 20);
   EXPECT_GE(r.stats.resolution, 32u);
   EXPECT_LE(r.stats.resolution, 128u);

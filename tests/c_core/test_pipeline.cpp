@@ -628,6 +628,19 @@ TEST(DacpoPipeline, StageTimesAddUp)
   EXPECT_GE(r.stats.ipsr_iterations_total, r.stats.ipsr_iterations_max);
   EXPECT_LE(r.stats.ipsr_iterations_max, p.ipsr_max_iterations);
   EXPECT_GT(r.stats.stage_seconds[DACPO_STAGE_IPSR], 0.0);
+  // the work profile: every block ran between 4 (the first four agreed) and
+  // all restarts of stage 2; stage 3 voted faces, and no more iterations kept
+  // their surface than ran
+  const size_t nb = r.stats.num_blocks;
+  ASSERT_GT(nb, 0u);
+  EXPECT_GE(r.stats.dipole_restarts_total, 4 * nb);
+  EXPECT_LE(r.stats.dipole_restarts_total, p.dipole_restarts * nb);
+  EXPECT_LE(r.stats.dipole_blocks_all_restarts, nb);
+  EXPECT_EQ(r.stats.dipole_restarts_total,
+            4 * nb + (p.dipole_restarts - 4) * r.stats.dipole_blocks_all_restarts);
+  EXPECT_GT(r.stats.ipsr_faces_total, 0u);
+  EXPECT_GE(r.stats.ipsr_cg_iterations_total, 1u);
+  EXPECT_LE(r.stats.ipsr_surfaces_reused, r.stats.ipsr_iterations_total);
 }
 
 // ---- determinism ----------------------------------------------------------------

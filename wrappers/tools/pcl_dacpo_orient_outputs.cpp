@@ -243,7 +243,9 @@ printStats(const Result& result)
                "layers=%g two_sheet=%g layered=%.3f copies=%.3f sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
-               "ipsr_iterations_max=%zu seconds=%.3f peak_rss_mb=%.1f\n",
+               "ipsr_iterations_max=%zu restarts=%zu blocks_all_restarts=%zu "
+               "ipsr_cg_steps=%zu ipsr_faces=%zu ipsr_reused=%zu "
+               "seconds=%.3f peak_rss_mb=%.1f\n",
                result.points,
                s.num_blocks,
                s.num_block_edges,
@@ -273,6 +275,11 @@ printStats(const Result& result)
                                   static_cast<double>(s.num_blocks)
                             : 0.0,
                s.ipsr_iterations_max,
+               s.dipole_restarts_total,
+               s.dipole_blocks_all_restarts,
+               s.ipsr_cg_iterations_total,
+               s.ipsr_faces_total,
+               s.ipsr_surfaces_reused,
                s.total_seconds,
                peakRssMb());
 }

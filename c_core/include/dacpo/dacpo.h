@@ -292,6 +292,16 @@ typedef struct dacpo_stats {
                                    copies all over it, the two-sheet rule is left
                                    out too and c is 1); 0 when the test did not
                                    run */
+  /** Where stages 2 and 3 spend their work, summed over blocks: stage-2
+   *  restarts run (a block stops after the first four when they agree, else
+   *  runs dipole_restarts) and the blocks that ran them all; stage-3 CG steps,
+   *  faces queried and voted, and iterations that kept the last surface (the
+   *  solve took no step). */
+  size_t dipole_restarts_total;
+  size_t dipole_blocks_all_restarts;
+  size_t ipsr_cg_iterations_total;
+  size_t ipsr_faces_total;
+  size_t ipsr_surfaces_reused;
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -55,6 +55,7 @@ unit_dipole_params(const dacpo_params* p, size_t b, uint8_t* thin, int8_t* cue)
   dp.sides_fit_k = p->scan_kind == DACPO_SCAN_MULTI_VIEW ? 32 : 24;
   dp.thin_out = thin;
   dp.cue_out = cue;
+  dp.restarts_out = NULL;
   return dp;
 }
 
@@ -134,9 +135,12 @@ dacpo_block_unit_run(const dacpo_params* p,
     goto done;
   }
   dacpo_dipole_params dp = unit_dipole_params(p, block, thin, cue);
+  size_t restarts = 0;
+  dp.restarts_out = &restarts;
   const double t0 = dacpo_now();
   st = dacpo_dipole_orient_confidence(xyz, axes, n, &dp, sign, out->conf, err);
   out->seconds[0] = dacpo_now() - t0;
+  out->restarts = (uint32_t)restarts;
   if (st != DACPO_OK)
     goto done;
   /* the cue's points keep their stage-2 sign through stage 3 (ip.fixed) */
@@ -341,13 +345,14 @@ dacpo_block_result_pack(size_t block,
 {
   unit_header h = {{0}, block, n, n_own, (uint64_t)(has_mesh != 0)};
   memcpy(h.magic, result_magic, sizeof(h.magic));
-  *size = sizeof(h) + sizeof(out->cue_votes) + sizeof(out->seconds) +
+  *size = sizeof(h) + sizeof(out->cue_votes) + sizeof(out->restarts) + sizeof(out->seconds) +
           sizeof(out->ipsr) + 3 * n * sizeof(double) + n_own * sizeof(float) +
           (has_mesh ? mesh_bytes(&out->mesh) : 0);
   writer w = {NULL, 0};
   DACPO_TRY(alloc_bytes(*size, bytes, &w, err));
   put(&w, &h, sizeof(h));
   put(&w, out->cue_votes, sizeof(out->cue_votes));
+  put(&w, &out->restarts, sizeof(out->restarts));
   put(&w, out->seconds, sizeof(out->seconds));
   put(&w, &out->ipsr, sizeof(out->ipsr));
   put(&w, out->nrm, 3 * n * sizeof(double));
@@ -375,6 +380,7 @@ result_unpack(reader* r, unit_header* h, dacpo_block_out* out, dacpo_err* err)
     return DACPO_OOM(err);
   DACPO_CHECK(err,
               get(r, out->cue_votes, 2, sizeof(uint32_t)) &&
+                  get(r, &out->restarts, 1, sizeof(uint32_t)) &&
                   get(r, out->seconds, 2, sizeof(double)) &&
                   get(r, &out->ipsr, 1, sizeof(out->ipsr)) &&
                   get(r, out->nrm, 3 * n, sizeof(double)) &&

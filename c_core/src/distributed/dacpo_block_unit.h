@@ -21,6 +21,7 @@ typedef struct dacpo_block_out {
   float* conf;           /* n_own: in-block confidence (halved where stage 3
                             turned the stage-2 sign over) */
   uint32_t cue_votes[2]; /* own points whose side cue agrees / disagrees */
+  uint32_t restarts;     /* stage-2 restarts run */
   dacpo_mesh mesh;       /* stage-3 mesh (only when asked for) */
   dacpo_ipsr_stats ipsr;
   double seconds[2]; /* stage 2, stage 3 */

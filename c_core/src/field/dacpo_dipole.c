@@ -536,6 +536,8 @@ dacpo_dipole_orient_confidence(const double* xyz,
     if (r + 1 == DACPO_DIPOLE_AGREE && R > r + 1 && restarts_agree(wk.cand, n, r + 1))
       R = r + 1;
   }
+  if (params->restarts_out)
+    *params->restarts_out = R;
   if (R > 1)
     dipole_vote(&wk, n, K, R, params->final_sweep, sign_out);
   else

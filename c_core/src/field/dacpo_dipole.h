@@ -40,6 +40,8 @@ typedef struct dacpo_dipole_params {
   int8_t* cue_out;   /* optional output (n entries, may be NULL): +1 where the
                         side cue fired and agrees with the returned sign, -1
                         where it disagrees, 0 elsewhere */
+  size_t* restarts_out; /* optional output (may be NULL): restarts run (fewer
+                           than `restarts` when the first ones agree) */
 } dacpo_dipole_params;
 
 /* The two-sheet test's local noise scale of point p (unit axis a): the 25th

@@ -39,6 +39,7 @@ typedef struct run_state {
   double* block_seconds;  /* per block: [2b] dipole, [2b+1] iPSR */
   uint8_t* flips;         /* per block */
   uint32_t* cue_votes;   /* 2 per block: own points whose side cue agrees / disagrees */
+  uint32_t* restarts;    /* per block: stage-2 restarts run */
   float* block_conf;     /* per block: how firmly stage 5 holds its flip */
   double evidence_scale; /* median alpha + alpha-bar of the block edges (stage 5) */
   int32_t* part;         /* n: part of each point (VIEWPOINT policy) */

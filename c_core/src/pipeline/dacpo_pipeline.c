@@ -60,6 +60,7 @@ run_state_free(run_state* s)
   free(s->block_seconds);
   free(s->flips);
   free(s->cue_votes);
+  free(s->restarts);
   free(s->block_conf);
   free(s->part);
   free(s->part_sign);
@@ -228,6 +229,7 @@ dacpo_run_store_block(run_state* s, size_t b, dacpo_block_out* out)
     memcpy(s->ring_oriented + 3 * ring0, out->nrm + 3 * no, 3 * nr * sizeof(double));
   s->cue_votes[2 * b] = out->cue_votes[0];
   s->cue_votes[2 * b + 1] = out->cue_votes[1];
+  s->restarts[b] = out->restarts;
   s->block_seconds[2 * b] = out->seconds[0];
   s->block_seconds[2 * b + 1] = out->seconds[1];
   s->ipsr[b] = out->ipsr;
@@ -483,6 +485,7 @@ alloc_block_results(run_state* s, dacpo_err* err)
   s->ipsr = dacpo_calloc_array(nb, sizeof(dacpo_ipsr_stats));
   s->block_seconds = dacpo_calloc_array(2 * nb, sizeof(double));
   s->cue_votes = dacpo_calloc_array(2 * nb, sizeof(uint32_t));
+  s->restarts = dacpo_calloc_array(nb, sizeof(uint32_t));
   const int want_meshes = s->p.edge_weight == DACPO_WEIGHT_VCR;
   if (want_meshes)
     s->meshes = dacpo_calloc_array(nb, sizeof(dacpo_mesh));
@@ -492,7 +495,7 @@ alloc_block_results(run_state* s, dacpo_err* err)
   s->block_done = dacpo_calloc_array(nb + 1, 1);
   s->edge_done = dacpo_calloc_array(s->bgraph.num_edges + 1, 1);
   if (!s->oriented || !s->point_conf || !s->ipsr || !s->block_seconds ||
-      !s->cue_votes || (want_meshes && !s->meshes) ||
+      !s->cue_votes || !s->restarts || (want_meshes && !s->meshes) ||
       (want_ring && !s->ring_oriented) || !s->block_done || !s->edge_done)
     return DACPO_OOM(err);
   return DACPO_OK;
@@ -811,10 +814,18 @@ job_solve(dacpo_job* job, dacpo_err* err)
       err, !s->solved, DACPO_ERR_INVALID_ARGUMENT, "job: the flips are solved already");
   s->solved = 1;
   st->ipsr_iterations_total = st->ipsr_iterations_max = 0;
+  st->dipole_restarts_total = st->dipole_blocks_all_restarts = 0;
+  st->ipsr_cg_iterations_total = st->ipsr_faces_total = st->ipsr_surfaces_reused = 0;
   for (size_t b = 0; b < s->blocks.num_blocks; ++b) {
     st->ipsr_iterations_total += s->ipsr[b].iterations;
     if (s->ipsr[b].iterations > st->ipsr_iterations_max)
       st->ipsr_iterations_max = s->ipsr[b].iterations;
+    st->ipsr_cg_iterations_total += s->ipsr[b].cg_iterations;
+    st->ipsr_faces_total += s->ipsr[b].faces_total;
+    st->ipsr_surfaces_reused += s->ipsr[b].surfaces_reused;
+    st->dipole_restarts_total += s->restarts[b];
+    st->dipole_blocks_all_restarts +=
+        s->restarts[b] > 0 && s->restarts[b] >= s->p.dipole_restarts;
   }
   DACPO_TRY(dacpo_sign_passes(s, st, err));
   return stage_done(job, DACPO_STAGE_ILP, err);

@@ -657,10 +657,14 @@ ipsr_iterate(ipsr_work* w,
     run->mesh_trimmed = trimming;
     if (iters == 0)
       break;
-    if (run->same)
+    if (run->same) {
       memset(w->change, 0, n * sizeof(double)); /* the vote would repeat nrm */
-    else
+      st->surfaces_reused++;
+    }
+    else {
       ipsr_vote(w, run->mesh, k, params->fixed, nrm, old, n);
+      st->faces_total += run->mesh->num_triangles;
+    }
     t[3] = dacpo_now();
     ipsr_iteration_stats(w, run->mesh, k, it, t, st);
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);

@@ -55,6 +55,8 @@ typedef struct dacpo_ipsr_stats {
   double extract_seconds; /* marching cubes */
   double vote_seconds;    /* face k-NN, trimming, normal update */
   size_t faces;           /* faces of the last iteration's mesh */
+  size_t faces_total;     /* faces queried and voted, summed over iterations */
+  size_t surfaces_reused; /* iterations whose solve left the surface as it was */
   double final_change;    /* last convergence measure */
   int converged;          /* 1 if it stopped on the convergence test */
   size_t domain_cells;    /* cells the Poisson solve works on (<= dims product) */
