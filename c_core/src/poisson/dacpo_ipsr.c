@@ -227,8 +227,7 @@ estimate_spacing(
   double* tmp = (double*)dacpo_malloc_array(n, sizeof(double));
   if (!tmp)
     return DACPO_OOM(err);
-  for (size_t pos = 0; pos < n; ++pos) { /* tree order: the tree stays in cache */
-    const size_t i = (size_t)dacpo_kdtree_order_at(w->tree, pos);
+  for (size_t i = 0; i < n; ++i) {
     w->area[i] = dacpo_kdtree_sample_area(w->tree, xyz + 3 * i);
     tmp[i] = w->area[i];
   }
