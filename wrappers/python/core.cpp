@@ -268,6 +268,13 @@ statsDict(const dacpo_stats* s)
   stats["dipole_layers_used"] = s->dipole_layers_used;
   stats["dipole_two_sheet_used"] = s->dipole_two_sheet_used;
   stats["total_seconds"] = s->total_seconds;
+  stats["ipsr_iterations_total"] = s->ipsr_iterations_total;
+  stats["ipsr_iterations_max"] = s->ipsr_iterations_max;
+  stats["dipole_restarts_total"] = s->dipole_restarts_total;
+  stats["dipole_blocks_all_restarts"] = s->dipole_blocks_all_restarts;
+  stats["ipsr_cg_iterations_total"] = s->ipsr_cg_iterations_total;
+  stats["ipsr_faces_total"] = s->ipsr_faces_total;
+  stats["ipsr_surfaces_reused"] = s->ipsr_surfaces_reused;
   py::dict stage_seconds;
   for (int i = 0; i < DACPO_STAGE_COUNT; ++i)
     stage_seconds[dacpo_stage_name(static_cast<dacpo_stage>(i))] = s->stage_seconds[i];

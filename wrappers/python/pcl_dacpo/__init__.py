@@ -44,7 +44,8 @@ class OrientResult:
     """What one ``orient`` call found besides the normals.
 
     Attributes: ``stats`` (dict: points, blocks, edges, components, flips, sign
-    policy outcome, ``stage_seconds``), ``component_labels`` and
+    policy outcome, ``stage_seconds``, and the work of stages 2-3:
+    ``dipole_restarts_total``, ``ipsr_iterations_total``, ...), ``component_labels`` and
     ``block_labels`` (int32 per point, input order), ``block_flips`` (uint8 per
     block), ``confidence`` (float32 per point in [0, 1]: how sure the sign is),
     ``seconds`` (the core's wall time).

@@ -39,6 +39,12 @@ def test_open_box_estimated_normals_face_into_the_box():
     assert result.block_labels.shape == (10000,)
     assert result.block_flips.shape == (result.stats["num_blocks"],)
     assert result.confidence.min() >= 0.0 and result.confidence.max() <= 1.0
+    # the work of stages 2-3: each block ran 4 (the first agreed) or all 16 restarts
+    nb = result.stats["num_blocks"]
+    all16 = result.stats["dipole_blocks_all_restarts"]
+    assert result.stats["dipole_restarts_total"] == 4 * nb + 12 * all16
+    assert result.stats["ipsr_iterations_total"] >= result.stats["ipsr_iterations_max"] > 0
+    assert result.stats["ipsr_faces_total"] > 0
 
 
 def test_sphere_given_axes_come_out_outward():
