@@ -11,6 +11,7 @@
 #include <sys/types.h>
 
 #include <errno.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +27,20 @@ typedef struct ply_parse {
   char* err;
   size_t errlen;
 } ply_parse;
+
+/* The parse's error at its current line; returns DACPO_PLY_ERR_FORMAT. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static int
+ply_bad(const ply_parse* ps, const char* fmt, ...)
+{
+  va_list ap;
+  va_start(ap, fmt);
+  dacpo_support_file_verr(ps->err, ps->errlen, ps->path, "PLY", ps->line, fmt, ap);
+  va_end(ap);
+  return DACPO_PLY_ERR_FORMAT;
+}
 
 static ply_type
 parse_type(const char* s)
@@ -114,15 +129,10 @@ header_format(ply_header* h, char** tok, int nt, ply_parse* ps)
 {
   if (nt < 2 || (strcmp(tok[1], "ascii") && strcmp(tok[1], "binary_little_endian") &&
                  strcmp(tok[1], "binary_big_endian"))) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "unsupported format '%s' (ascii, binary_little_endian or "
-                           "binary_big_endian)",
-                           nt > 1 ? tok[1] : "");
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(
+        ps,
+        "unsupported format '%s' (ascii, binary_little_endian or binary_big_endian)",
+        nt > 1 ? tok[1] : "");
   }
   h->format = strcmp(tok[1], "ascii") == 0                  ? FMT_ASCII
               : strcmp(tok[1], "binary_little_endian") == 0 ? FMT_BLE
@@ -136,37 +146,16 @@ header_element(ply_header* h, char** tok, int nt, ply_parse* ps)
 {
   ply_element* e;
   if (nt != 3) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "'element NAME COUNT' expected");
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "'element NAME COUNT' expected");
   }
   if (h->nel >= PLY_MAX_ELEMENTS) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "more than %d elements",
-                           PLY_MAX_ELEMENTS);
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "more than %d elements", PLY_MAX_ELEMENTS);
   }
   e = &h->el[h->nel++];
   memset(e, 0, sizeof(*e));
   snprintf(e->name, sizeof(e->name), "%s", tok[1]);
   if (parse_count(tok[2], &e->count) != 0) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "bad count '%s' for element '%s'",
-                           tok[2],
-                           e->name);
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "bad count '%s' for element '%s'", tok[2], e->name);
   }
   return DACPO_PLY_OK;
 }
@@ -202,28 +191,14 @@ header_property(ply_header* h, char** tok, int nt, ply_parse* ps)
   ply_element* e = h->nel > 0 ? &h->el[h->nel - 1] : NULL;
   const char* why = NULL;
   if (!e) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "a property before any element");
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "a property before any element");
   }
   if (e->nprops >= PLY_MAX_PROPS) {
-    dacpo_support_file_err(ps->err,
-                           ps->errlen,
-                           ps->path,
-                           "PLY",
-                           ps->line,
-                           "more than %d properties in element '%s'",
-                           PLY_MAX_PROPS,
-                           e->name);
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(
+        ps, "more than %d properties in element '%s'", PLY_MAX_PROPS, e->name);
   }
   if (!property_types(&e->props[e->nprops], tok, nt, &why)) {
-    dacpo_support_file_err(ps->err, ps->errlen, ps->path, "PLY", ps->line, "%s", why);
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "%s", why);
   }
   e->nprops++;
   return DACPO_PLY_OK;
@@ -241,9 +216,7 @@ header_line(ply_header* h, char* line, int* have_format, ply_parse* ps)
   if (strcmp(tok[0], "end_header") == 0) {
     if (*have_format)
       return 1;
-    dacpo_support_file_err(
-        ps->err, ps->errlen, ps->path, "PLY", ps->line, "no format line");
-    return DACPO_PLY_ERR_FORMAT;
+    return ply_bad(ps, "no format line");
   }
   if (strcmp(tok[0], "format") == 0) {
     *have_format = 1;
@@ -253,9 +226,7 @@ header_line(ply_header* h, char* line, int* have_format, ply_parse* ps)
     return header_element(h, tok, nt, ps);
   if (strcmp(tok[0], "property") == 0)
     return header_property(h, tok, nt, ps);
-  dacpo_support_file_err(
-      ps->err, ps->errlen, ps->path, "PLY", ps->line, "unknown keyword '%s'", tok[0]);
-  return DACPO_PLY_ERR_FORMAT;
+  return ply_bad(ps, "unknown keyword '%s'", tok[0]);
 }
 
 /* The first line: "ply" alone (blanks around it allowed). */

@@ -24,13 +24,25 @@ dacpo_support_file_err(char* err,
                        const char* fmt,
                        ...)
 {
-  char what[512];
   va_list ap;
+  va_start(ap, fmt);
+  dacpo_support_file_verr(err, errlen, path, kind, line, fmt, ap);
+  va_end(ap);
+}
+
+void
+dacpo_support_file_verr(char* err,
+                        size_t errlen,
+                        const char* path,
+                        const char* kind,
+                        long line,
+                        const char* fmt,
+                        va_list ap)
+{
+  char what[512];
   if (!err || errlen == 0)
     return;
-  va_start(ap, fmt);
   vsnprintf(what, sizeof(what), fmt, ap);
-  va_end(ap);
   for (char* c = what; *c; ++c)
     if ((unsigned char)*c < 32 || (unsigned char)*c > 126)
       *c = '?';

@@ -5,6 +5,7 @@
 #ifndef DACPO_SUPPORT_ERR_H
 #define DACPO_SUPPORT_ERR_H
 
+#include <stdarg.h>
 #include <stddef.h>
 
 #if defined(__GNUC__)
@@ -27,5 +28,16 @@ dacpo_support_file_err(char* err,
                        long line,
                        const char* fmt,
                        ...);
+
+/* dacpo_support_file_err with the arguments in a va_list (for helpers that
+ * add their own context). */
+void
+dacpo_support_file_verr(char* err,
+                        size_t errlen,
+                        const char* path,
+                        const char* kind,
+                        long line,
+                        const char* fmt,
+                        va_list ap);
 
 #endif /* DACPO_SUPPORT_ERR_H */

@@ -23,47 +23,38 @@ hasFields(const pcl::PCLPointCloud2& cloud, std::initializer_list<const char*> n
   return true;
 }
 
+namespace {
+/* One value of type T at p (any alignment). */
+template <typename T>
+double
+load(const std::uint8_t* p)
+{
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return static_cast<double>(v);
+}
+} // namespace
+
 double
 readValue(const std::uint8_t* p, std::uint8_t datatype)
 {
   switch (datatype) {
-  case pcl::PCLPointField::INT8: {
-    std::int8_t v;
-    std::memcpy(&v, p, 1);
-    return v;
-  }
+  case pcl::PCLPointField::INT8:
+    return load<std::int8_t>(p);
   case pcl::PCLPointField::UINT8:
-    return *p;
-  case pcl::PCLPointField::INT16: {
-    std::int16_t v;
-    std::memcpy(&v, p, 2);
-    return v;
-  }
-  case pcl::PCLPointField::UINT16: {
-    std::uint16_t v;
-    std::memcpy(&v, p, 2);
-    return v;
-  }
-  case pcl::PCLPointField::INT32: {
-    std::int32_t v;
-    std::memcpy(&v, p, 4);
-    return v;
-  }
-  case pcl::PCLPointField::UINT32: {
-    std::uint32_t v;
-    std::memcpy(&v, p, 4);
-    return v;
-  }
-  case pcl::PCLPointField::FLOAT32: {
-    float v;
-    std::memcpy(&v, p, 4);
-    return v;
-  }
-  case pcl::PCLPointField::FLOAT64: {
-    double v;
-    std::memcpy(&v, p, 8);
-    return v;
-  }
+    return load<std::uint8_t>(p);
+  case pcl::PCLPointField::INT16:
+    return load<std::int16_t>(p);
+  case pcl::PCLPointField::UINT16:
+    return load<std::uint16_t>(p);
+  case pcl::PCLPointField::INT32:
+    return load<std::int32_t>(p);
+  case pcl::PCLPointField::UINT32:
+    return load<std::uint32_t>(p);
+  case pcl::PCLPointField::FLOAT32:
+    return load<float>(p);
+  case pcl::PCLPointField::FLOAT64:
+    return load<double>(p);
   default:
     return std::numeric_limits<double>::quiet_NaN();
   }
