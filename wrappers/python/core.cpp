@@ -263,6 +263,7 @@ statsDict(const dacpo_stats* s)
   stats["single_view_fit"] = s->single_view_fit;
   stats["layered_share"] = s->layered_share;
   stats["layered_copies"] = s->layered_copies;
+  stats["layered_doubled"] = s->layered_doubled;
   stats["dipole_sides_used"] = s->dipole_sides_used;
   stats["dipole_c_used"] = s->dipole_c_used;
   stats["dipole_layers_used"] = s->dipole_layers_used;

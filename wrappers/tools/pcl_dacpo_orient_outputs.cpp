@@ -240,7 +240,7 @@ printStats(const Result& result)
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu scan=%s single_view_fit=%.3f c=%g "
-               "layers=%g two_sheet=%g layered=%.3f copies=%.3f sides=%g "
+               "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu restarts=%zu blocks_all_restarts=%zu "
@@ -266,6 +266,7 @@ printStats(const Result& result)
                s.dipole_two_sheet_used,
                s.layered_share,
                s.layered_copies,
+               s.layered_doubled,
                s.dipole_sides_used,
                s.sign_flipped,
                s.sign_facing,

@@ -302,6 +302,12 @@ typedef struct dacpo_stats {
   size_t ipsr_cg_iterations_total;
   size_t ipsr_faces_total;
   size_t ipsr_surfaces_reused;
+  double layered_doubled;     /**< AUTO resolved to many views: on the same plane,
+                                   the share of its surface points with a second
+                                   parallel sheet anywhere within two band widths
+                                   (>= 0.5: copies wider apart than the pair
+                                   window, handled as layered_copies >= 0.04);
+                                   0 when the test did not run */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

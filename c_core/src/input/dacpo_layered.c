@@ -54,6 +54,8 @@
 
 #define LAYERED_PAIR_NOISE 3.0 /* stage 2's default two-sheet factor */
 #define LAYERED_PAIRS 3
+#define LAYERED_GRID                                                                   \
+  2048.0 /* cells of the band's footprint along its longer side, at most */
 
 static double
 dot3(const double* a, const double* b)
@@ -229,27 +231,104 @@ spans_scene(const double* xyz,
   return fmin(hi1 - lo1, hi2 - lo2) >= depth;
 }
 
-/* The copy rate of the band [lo, lo + width] along dir (nb_band points):
- * the share of up to DACPO_LAYERED_SAMPLE points of the surface itself with a
- * second parallel sheet (stage 2's two-sheet pair test). */
+/* The slab around the band, [lo - width, lo + 2 width] along dir: its points
+ * parallel to the band, projected onto the band's plane (third coordinate 0),
+ * and their indices. */
+typedef struct {
+  dacpo_kdtree* tree; /* over the projected points */
+  size_t* index;      /* slab point -> cloud index */
+  double e1[3], e2[3];
+} slab_plane;
+
 static dacpo_status
-copy_rate(const double* xyz,
-          const double* axes,
-          size_t n,
-          const int32_t* knn_idx,
-          const float* knn_sqd,
-          size_t knn_k,
-          const double dir[3],
-          double lo,
-          double width,
-          size_t nb_band,
-          double spacing,
-          double* rate,
-          dacpo_err* err)
+slab_plane_build(const double* xyz,
+                 const double* axes,
+                 size_t n,
+                 const double dir[3],
+                 double lo,
+                 double width,
+                 slab_plane* sp,
+                 dacpo_err* err)
 {
-  /* The surface itself: the densest slab one spacing thick within the band
-   * (a thing resting a spacing above the floor is not sampled; a copy of the
-   * floor within two spacings of the slab still counts). */
+  dacpo_tangent_frame(dir, sp->e1, sp->e2);
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    m += y >= lo - width && y <= lo + 2.0 * width &&
+         fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
+  }
+  double* uv = dacpo_malloc_array(3 * m, sizeof(double));
+  sp->index = dacpo_malloc_array(m, sizeof(size_t));
+  dacpo_status st = uv && sp->index ? DACPO_OK : DACPO_OOM(err);
+  for (size_t i = 0, t = 0; i < n && st == DACPO_OK; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    if (y < lo - width || y > lo + 2.0 * width ||
+        fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+      continue;
+    uv[3 * t] = dot3(sp->e1, xyz + 3 * i);
+    uv[3 * t + 1] = dot3(sp->e2, xyz + 3 * i);
+    uv[3 * t + 2] = 0.0;
+    sp->index[t++] = i;
+  }
+  if (st == DACPO_OK)
+    st = dacpo_kdtree_build(uv, m, &sp->tree, err);
+  free(uv);
+  return st;
+}
+
+/* 1 if point i has a second parallel sheet anywhere in the slab: among its
+ * LAYERED_K nearest slab points in the plane (every copy stacked over it, where
+ * its nearest in space all lie on its own copy), stage 2's pair test with the
+ * window widened to the slab's reach beyond the band (2 x width). */
+static int
+has_sheet_in_slab(const double* xyz,
+                  const double* axes,
+                  const int32_t* idx,
+                  size_t k,
+                  const slab_plane* sp,
+                  size_t i,
+                  double width,
+                  double spacing)
+{
+  const double* p = xyz + 3 * i;
+  const double q[3] = {dot3(sp->e1, p), dot3(sp->e2, p), 0.0};
+  int32_t nb[LAYERED_K + 1];
+  double d2[LAYERED_K + 1];
+  const size_t got = dacpo_kdtree_knn(sp->tree, q, LAYERED_K + 1, nb, d2);
+  const double noise_i = local_noise(xyz, axes, idx, k, i);
+  size_t pairs = 0;
+  for (size_t t = 0; t < got && pairs < LAYERED_PAIRS; ++t) {
+    const size_t j = sp->index[nb[t]];
+    if (j != i)
+      pairs += dacpo_two_sheet_pair(p,
+                                    axes + 3 * i,
+                                    xyz + 3 * j,
+                                    axes + 3 * j,
+                                    fmax(noise_i, local_noise(xyz, axes, idx, k, j)),
+                                    width,
+                                    LAYERED_PAIR_NOISE,
+                                    spacing);
+  }
+  return pairs >= LAYERED_PAIRS;
+}
+
+/* The surface itself: the densest slab one spacing thick within the band
+ * [lo, lo + width] along dir (a thing resting a spacing above the floor is not
+ * sampled; a copy of the floor within two spacings of it still counts). Its
+ * start in *at, its count returned. */
+static dacpo_status
+band_surface(const double* xyz,
+             const double* axes,
+             size_t n,
+             const double dir[3],
+             double lo,
+             double width,
+             size_t nb_band,
+             double spacing,
+             double* at,
+             size_t* on_surface,
+             dacpo_err* err)
+{
   double* y = dacpo_malloc_array(nb_band, sizeof(double));
   if (!y)
     return DACPO_OOM(err);
@@ -260,23 +339,109 @@ copy_rate(const double* xyz,
       y[ny++] = yi;
   }
   qsort(y, ny, sizeof(double), dacpo_cmp_double);
-  double at = lo;
-  const size_t on_surface = densest_window(y, ny, spacing, &at);
+  *at = lo;
+  *on_surface = densest_window(y, ny, spacing, at);
   free(y);
+  return DACPO_OK;
+}
+
+/* The copy rates of the band [lo, lo + width] along dir (nb_band points),
+ * over up to DACPO_LAYERED_SAMPLE points of its surface: *rate, the share
+ * with a second parallel sheet among their nearest (stage 2's two-sheet pair
+ * test), and *doubled, the share with one anywhere in the slab. */
+static dacpo_status
+copy_rates(const double* xyz,
+           const double* axes,
+           size_t n,
+           const int32_t* knn_idx,
+           const float* knn_sqd,
+           size_t knn_k,
+           const double dir[3],
+           double lo,
+           double width,
+           size_t nb_band,
+           double spacing,
+           double* rate,
+           double* doubled,
+           dacpo_err* err)
+{
+  double at = lo;
+  size_t on_surface = 0;
+  DACPO_TRY(band_surface(
+      xyz, axes, n, dir, lo, width, nb_band, spacing, &at, &on_surface, err));
+  slab_plane sp = {NULL, NULL, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+  dacpo_status st = slab_plane_build(xyz, axes, n, dir, lo, width, &sp, err);
   /* every (on_surface / s)-th point of it */
   const size_t s =
       on_surface < DACPO_LAYERED_SAMPLE ? on_surface : DACPO_LAYERED_SAMPLE;
-  size_t seen = 0, taken = 0, copies = 0;
-  for (size_t i = 0; i < n && taken < s; ++i) {
+  size_t seen = 0, taken = 0, copies = 0, stacked = 0;
+  for (size_t i = 0; i < n && taken < s && st == DACPO_OK; ++i) {
     const double yi = dot3(dir, xyz + 3 * i);
     if (yi < at || yi > at + spacing || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
       continue;
     if (seen++ * s >= taken * on_surface) {
       taken++;
       copies += has_second_sheet(xyz, axes, knn_idx, knn_sqd, knn_k, i, spacing);
+      stacked += has_sheet_in_slab(xyz, axes, knn_idx, knn_k, &sp, i, width, spacing);
     }
   }
+  dacpo_kdtree_free(sp.tree);
+  free(sp.index);
   *rate = taken ? (double)copies / (double)taken : 0.0;
+  *doubled = taken ? (double)stacked / (double)taken : 0.0;
+  return st;
+}
+
+/* The points beyond the slab [lo - width, lo + 2 width] along dir on the side
+ * with fewer of them (below: the lower side) that lie under the band: in a
+ * cell (width wide, in the band's plane) that holds a band point. A floor has
+ * nothing beneath it; things beside it (a lower floor through a doorway) are
+ * not beneath it. */
+static dacpo_status
+minority_under_band(const double* xyz,
+                    const double* axes,
+                    size_t n,
+                    const double dir[3],
+                    double lo,
+                    double width,
+                    int below,
+                    size_t* count,
+                    dacpo_err* err)
+{
+  double e1[3], e2[3], u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+  dacpo_tangent_frame(dir, e1, e2);
+  for (size_t i = 0; i < n; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    if (y < lo || y > lo + width || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+      continue;
+    u0 = fmin(u0, dot3(e1, xyz + 3 * i));
+    u1 = fmax(u1, dot3(e1, xyz + 3 * i));
+    v0 = fmin(v0, dot3(e2, xyz + 3 * i));
+    v1 = fmax(v1, dot3(e2, xyz + 3 * i));
+  }
+  /* at most LAYERED_GRID cells along either side */
+  const double cell = fmax(width, fmax(u1 - u0, v1 - v0) / LAYERED_GRID);
+  const size_t nu = (size_t)((u1 - u0) / cell) + 1, nv = (size_t)((v1 - v0) / cell) + 1;
+  unsigned char* under = calloc(nu * nv, 1);
+  if (!under)
+    return DACPO_OOM(err);
+  *count = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (size_t i = 0; i < n; ++i) {
+      const double y = dot3(dir, xyz + 3 * i);
+      const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
+      const int band =
+          y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
+      const int beyond = below ? y < lo - width : y > lo + 2.0 * width;
+      if (!(pass == 0 ? band : beyond) || u < u0 || u > u1 || v < v0 || v > v1)
+        continue;
+      const size_t c = (size_t)((u - u0) / cell) * nv + (size_t)((v - v0) / cell);
+      if (pass == 0)
+        under[c] = 1;
+      else
+        *count += under[c];
+    }
+  free(under);
   return DACPO_OK;
 }
 
@@ -445,14 +610,16 @@ dacpo_layered_share(const double* xyz,
                     size_t knn_k,
                     double* share,
                     double* copies,
+                    double* doubled,
                     dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && axes && knn_idx && knn_sqd && share && copies,
+              xyz && axes && knn_idx && knn_sqd && share && copies && doubled,
               DACPO_ERR_INVALID_ARGUMENT,
               "layered test: NULL argument");
   *share = 0.0;
   *copies = 0.0;
+  *doubled = 0.0;
   if (n <= LAYERED_K || knn_k < LAYERED_PAIRS)
     return DACPO_OK;
   double spacing = 0.0, dir[3] = {0.0, 0.0, 0.0}, lo = 0.0;
@@ -481,24 +648,28 @@ dacpo_layered_share(const double* xyz,
    * seen from inside, cannot be a thin solid: a board or a partition has
    * things on both sides, or nothing at all (a scan of one board). */
   const size_t beyond = below + above;
-  const size_t minority = below < above ? below : above;
+  size_t minority = 0;
   if (nb_band < DACPO_LAYERED_MIN_BAND ||
-      (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n ||
-      (double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
+      (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n)
+    return DACPO_OK;
+  DACPO_TRY(
+      minority_under_band(xyz, axes, n, dir, lo, width, below < above, &minority, err));
+  if ((double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
     return DACPO_OK;
   if (spans_scene(xyz, axes, n, dir, lo, width))
-    DACPO_TRY(copy_rate(xyz,
-                        axes,
-                        n,
-                        knn_idx,
-                        knn_sqd,
-                        knn_k,
-                        dir,
-                        lo,
-                        width,
-                        nb_band,
-                        spacing,
-                        copies,
-                        err));
+    DACPO_TRY(copy_rates(xyz,
+                         axes,
+                         n,
+                         knn_idx,
+                         knn_sqd,
+                         knn_k,
+                         dir,
+                         lo,
+                         width,
+                         nb_band,
+                         spacing,
+                         copies,
+                         doubled,
+                         err));
   return side_share(xyz, axes, n, dir, lo, width, ns, nb_band, spacing, share, err);
 }

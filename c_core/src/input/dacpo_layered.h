@@ -19,8 +19,11 @@
  * *copies (the copy rate): on the same band, if it qualifies, the share of up
  * to DACPO_LAYERED_SAMPLE points of the surface itself (the densest slab one
  * spacing thick in the band) that have a second parallel sheet within two
- * spacings: stage 2's two-sheet pair test. 0 where *share is 0 for want of a
- * band.
+ * spacings: stage 2's two-sheet pair test. *doubled: the share of the same
+ * points with a second parallel sheet anywhere in the slab (up to two band
+ * widths from them, among their nearest in the plane): copies wider apart
+ * than the pair window, as whole frames off by 2 cm. Both 0 where *share is 0
+ * for want of a band.
  *
  * xyz, axes: n points and unit axes (3n each); knn_idx, knn_sqd: n x knn_k
  * nearest neighbours (self excluded, nearest first, -1 / inf padded) and their
@@ -35,12 +38,17 @@ dacpo_layered_share(const double* xyz,
                     size_t knn_k,
                     double* share,
                     double* copies,
+                    double* doubled,
                     dacpo_err* err);
 /* From this copy rate on, the two-sheet rule (its pairs and c_thin) is left
  * out as well as the side cue: copies lie on the floor everywhere, not only
  * where a thing rests close above it. Values measured and margins:
  * docs/DESIGN.md ("Copies or thin solids"). */
 #define DACPO_LAYERED_COPIES 0.04
+/* ... or from this share of the floor in two sheets or more anywhere in the
+ * slab: most of it (things resting on a floor cover a part of it). Values
+ * measured and margins: docs/DESIGN.md ("Copies or thin solids"). */
+#define DACPO_LAYERED_DOUBLED 0.5
 
 /* From this share of the band the scene counts as layered and the side cue
  * is left out (dacpo_pipeline.c). Measured with PCA axes: 18 shared rooms and
@@ -56,9 +64,10 @@ dacpo_layered_share(const double* xyz,
 /* Sampled points a band needs before it says anything. */
 #define DACPO_LAYERED_MIN_BAND 64
 /* The band must have the scene on one side: at least this share of all points
- * lies beyond its slab, and at most this share of those on its other side (a
- * floor has none beneath it; two sheets alone, or a partition in a room, do
- * not qualify). */
+ * lies beyond its slab, and at most this share of those on its other side
+ * under the band (a floor has none beneath it; two sheets alone, or a
+ * partition in a room, do not qualify; things beside a floor, lower than it,
+ * are not beneath it). */
 #define DACPO_LAYERED_MIN_BEYOND 0.1
 #define DACPO_LAYERED_MAX_OTHER_SIDE 0.02
 

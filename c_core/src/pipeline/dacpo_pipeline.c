@@ -575,6 +575,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->single_view_fit = 0.0;
   st->layered_share = 0.0;
   st->layered_copies = 0.0;
+  st->layered_doubled = 0.0;
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
     double fit = 0.0, slope = 0.0;
     DACPO_TRY(dacpo_single_view_fit(
@@ -595,13 +596,15 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
                                     s->knn.k,
                                     &st->layered_share,
                                     &st->layered_copies,
+                                    &st->layered_doubled,
                                     err));
-      if (st->layered_share >= DACPO_LAYERED_SHARE ||
-          st->layered_copies >= DACPO_LAYERED_COPIES)
+      const int copies = st->layered_copies >= DACPO_LAYERED_COPIES ||
+                         st->layered_doubled >= DACPO_LAYERED_DOUBLED;
+      if (st->layered_share >= DACPO_LAYERED_SHARE || copies)
         s->p.dipole_sides = 0.0;
       /* copies are layers of one surface seen from one side: c = 1 as for a
        * single view (Eq. 1's stacked vote reads them as opposite faces) */
-      if (st->layered_copies >= DACPO_LAYERED_COPIES) {
+      if (copies) {
         s->p.dipole_two_sheet = 0.0;
         if (s->p.dipole_c < 0.0)
           s->p.dipole_c = 1.0;
