@@ -63,6 +63,42 @@ dot3(const double* a, const double* b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* 1 if point p (axis a) lies in the band [lo, lo + width] along dir and is
+ * parallel to it. */
+static int
+in_band(const double dir[3], double lo, double width, const double* p, const double* a)
+{
+  const double y = dot3(dir, p);
+  return y >= lo && y <= lo + width && fabs(dot3(dir, a)) > LAYERED_COS;
+}
+
+/* The box of the band's points in its plane: frame e1, e2, box = u0, u1, v0,
+ * v1 (empty: +inf, -inf). */
+static void
+band_box(const double* xyz,
+         const double* axes,
+         size_t n,
+         const double dir[3],
+         double lo,
+         double width,
+         double e1[3],
+         double e2[3],
+         double box[4])
+{
+  dacpo_tangent_frame(dir, e1, e2);
+  box[0] = box[2] = INFINITY;
+  box[1] = box[3] = -INFINITY;
+  for (size_t i = 0; i < n; ++i) {
+    if (!in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i))
+      continue;
+    const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
+    box[0] = fmin(box[0], u);
+    box[1] = fmax(box[1], u);
+    box[2] = fmin(box[2], v);
+    box[3] = fmax(box[3], v);
+  }
+}
+
 /* Stage 2's local noise scale of point i, from its k nearest. */
 static double
 local_noise(
@@ -214,21 +250,13 @@ spans_scene(const double* xyz,
             double lo,
             double width)
 {
-  double e1[3], e2[3];
-  dacpo_tangent_frame(dir, e1, e2);
-  double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY, depth = 0.0;
+  double e1[3], e2[3], box[4], depth = 0.0;
+  band_box(xyz, axes, n, dir, lo, width, e1, e2, box);
   for (size_t i = 0; i < n; ++i) {
-    const double* p = xyz + 3 * i;
-    const double y = dot3(dir, p);
+    const double y = dot3(dir, xyz + 3 * i);
     depth = fmax(depth, fmax(lo - y, y - lo - width));
-    if (y < lo || y > lo + width || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
-      continue;
-    lo1 = fmin(lo1, dot3(e1, p));
-    hi1 = fmax(hi1, dot3(e1, p));
-    lo2 = fmin(lo2, dot3(e2, p));
-    hi2 = fmax(hi2, dot3(e2, p));
   }
-  return fmin(hi1 - lo1, hi2 - lo2) >= depth;
+  return fmin(box[1] - box[0], box[3] - box[2]) >= depth;
 }
 
 /* The slab around the band, [lo - width, lo + 2 width] along dir: its points
@@ -334,9 +362,8 @@ band_surface(const double* xyz,
     return DACPO_OOM(err);
   size_t ny = 0;
   for (size_t i = 0; i < n && ny < nb_band; ++i) {
-    const double yi = dot3(dir, xyz + 3 * i);
-    if (yi >= lo && yi <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS)
-      y[ny++] = yi;
+    if (in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i))
+      y[ny++] = dot3(dir, xyz + 3 * i);
   }
   qsort(y, ny, sizeof(double), dacpo_cmp_double);
   *at = lo;
@@ -408,17 +435,9 @@ minority_under_band(const double* xyz,
                     size_t* count,
                     dacpo_err* err)
 {
-  double e1[3], e2[3], u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
-  dacpo_tangent_frame(dir, e1, e2);
-  for (size_t i = 0; i < n; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y < lo || y > lo + width || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
-      continue;
-    u0 = fmin(u0, dot3(e1, xyz + 3 * i));
-    u1 = fmax(u1, dot3(e1, xyz + 3 * i));
-    v0 = fmin(v0, dot3(e2, xyz + 3 * i));
-    v1 = fmax(v1, dot3(e2, xyz + 3 * i));
-  }
+  double e1[3], e2[3], box[4];
+  band_box(xyz, axes, n, dir, lo, width, e1, e2, box);
+  const double u0 = box[0], u1 = box[1], v0 = box[2], v1 = box[3];
   /* at most LAYERED_GRID cells along either side */
   const double cell = fmax(width, fmax(u1 - u0, v1 - v0) / LAYERED_GRID);
   const size_t nu = (size_t)((u1 - u0) / cell) + 1, nv = (size_t)((v1 - v0) / cell) + 1;
@@ -430,8 +449,7 @@ minority_under_band(const double* xyz,
     for (size_t i = 0; i < n; ++i) {
       const double y = dot3(dir, xyz + 3 * i);
       const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
-      const int band =
-          y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
+      const int band = in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
       const int beyond = below ? y < lo - width : y > lo + 2.0 * width;
       if (!(pass == 0 ? band : beyond) || u < u0 || u > u1 || v < v0 || v > v1)
         continue;
@@ -555,7 +573,7 @@ side_share(const double* xyz,
       continue;
     memcpy(sxyz + 3 * at, xyz + 3 * i, 3 * sizeof(double));
     memcpy(saxes + 3 * at, axes + 3 * i, 3 * sizeof(double));
-    if (y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS) {
+    if (in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i)) {
       /* every (nb_band / s)-th band point */
       if (taken < s && seen * s >= taken * nb_band)
         pick[taken++] = at;
@@ -640,8 +658,7 @@ dacpo_layered_share(const double* xyz,
       above++;
     else {
       ns++;
-      nb_band +=
-          y >= lo && y <= lo + width && fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
+      nb_band += in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
     }
   }
   /* Only a plane with the scene on one side of it, like a floor or a wall
