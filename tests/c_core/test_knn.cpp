@@ -380,3 +380,30 @@ TEST(DacpoKnn, ComponentsOfIsolatedPointsAndEmptyGraph)
   ASSERT_EQ(dacpo_components_label(&empty, nullptr, &nc, &err), DACPO_OK);
   EXPECT_EQ(nc, 0u);
 }
+
+// After stage 1 only each row's reach is kept: its farthest finite squared
+// distance (+inf when a row has none), one column, the indices freed.
+TEST(DacpoKnn, KeepFarthestLeavesEachRowsReach)
+{
+  dacpo_knn_graph g{};
+  g.n = 3;
+  g.k = 3;
+  g.idx = static_cast<int32_t*>(malloc(9 * sizeof(int32_t)));
+  g.sqd = static_cast<float*>(malloc(9 * sizeof(float)));
+  ASSERT_TRUE(g.idx && g.sqd);
+  const float inf = INFINITY;
+  const float rows[9] = {1.0f, 4.0f, 2.0f, 0.5f, 0.25f, inf, inf, inf, inf};
+  for (int t = 0; t < 9; ++t) {
+    g.sqd[t] = rows[t];
+    g.idx[t] = t % 3;
+  }
+  dacpo_knn_graph_keep_farthest(&g);
+  EXPECT_EQ(g.k, 1u);
+  EXPECT_EQ(g.idx, nullptr);
+  EXPECT_EQ(g.sqd[0], 4.0f);
+  EXPECT_EQ(g.sqd[1], 0.5f);
+  EXPECT_TRUE(std::isinf(g.sqd[2]));
+  dacpo_knn_graph_keep_farthest(&g); // one column already: unchanged
+  EXPECT_EQ(g.sqd[0], 4.0f);
+  dacpo_knn_graph_free(&g);
+}

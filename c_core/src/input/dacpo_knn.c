@@ -297,6 +297,27 @@ dacpo_knn_graph_free(dacpo_knn_graph* g)
   memset(g, 0, sizeof(*g));
 }
 
+void
+dacpo_knn_graph_keep_farthest(dacpo_knn_graph* g)
+{
+  if (!g || !g->sqd || g->k <= 1)
+    return;
+  /* row i is read before slot i (part of an earlier row) is written */
+  for (size_t i = 0; i < g->n; ++i) {
+    float far = -1.0f;
+    for (size_t j = 0; j < g->k; ++j)
+      if (isfinite(g->sqd[i * g->k + j]) && g->sqd[i * g->k + j] > far)
+        far = g->sqd[i * g->k + j];
+    g->sqd[i] = far >= 0.0f ? far : INFINITY;
+  }
+  float* shrunk = realloc(g->sqd, (g->n ? g->n : 1) * sizeof(float));
+  if (shrunk)
+    g->sqd = shrunk;
+  free(g->idx);
+  g->idx = NULL;
+  g->k = 1;
+}
+
 /* ---- symmetric adjacency ------------------------------------------------ */
 
 static int

@@ -14,6 +14,15 @@ typedef struct dacpo_knn_graph {
   float* sqd;   /* n * k squared distances */
 } dacpo_knn_graph;
 
+/* Keeps of each row only its farthest finite squared distance (+inf for a
+ * row without one): g becomes one column (k = 1, idx freed). Stages after 1
+ * read the neighbours' reach, not who they are (the global sign's density
+ * model); the rows are the largest buffer of stages 0-1 (8 bytes per
+ * neighbour and point). No allocation: the column is written into sqd's
+ * first n slots, which shrink when realloc allows. */
+void
+dacpo_knn_graph_keep_farthest(dacpo_knn_graph* g);
+
 /* search == NULL or search->knn == NULL: built-in kd-tree. A caller's search
  * answers in input indices; they are mapped to distinct points, the query and its
  * duplicates dropped, and asked again with a larger k when too few remain.

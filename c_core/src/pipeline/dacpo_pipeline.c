@@ -672,6 +672,9 @@ job_prepare(dacpo_job* job,
     DACPO_TRY(estimate_normals(s, err));
   DACPO_TRY(resolve_scan_kind(s, st, err));
   DACPO_TRY(stage_done(job, DACPO_STAGE_NORMALS, err));
+  /* the neighbour rows are done with (the adjacency holds the graph); the
+   * global sign reads only each row's reach */
+  dacpo_knn_graph_keep_farthest(&s->knn);
   DACPO_TRY(segment_blocks(s, st, err));
   DACPO_TRY(alloc_block_results(s, err));
   return stage_done(job, DACPO_STAGE_SEGMENT, err);
