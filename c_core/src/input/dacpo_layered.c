@@ -54,8 +54,8 @@
 
 #define LAYERED_PAIR_NOISE 3.0 /* stage 2's default two-sheet factor */
 #define LAYERED_PAIRS 3
-#define LAYERED_GRID                                                                   \
-  2048.0 /* cells of the band's footprint along its longer side, at most */
+/* cells of the band's footprint along its longer side, at most */
+#define LAYERED_GRID 2048.0
 
 static double
 dot3(const double* a, const double* b)
@@ -70,6 +70,15 @@ in_band(const double dir[3], double lo, double width, const double* p, const dou
 {
   const double y = dot3(dir, p);
   return y >= lo && y <= lo + width && fabs(dot3(dir, a)) > LAYERED_COS;
+}
+
+/* 1 if point p (axis a) lies in the slab [lo - width, lo + 2 width] around
+ * the band along dir and is parallel to it. */
+static int
+in_slab(const double dir[3], double lo, double width, const double* p, const double* a)
+{
+  const double y = dot3(dir, p);
+  return y >= lo - width && y <= lo + 2.0 * width && fabs(dot3(dir, a)) > LAYERED_COS;
 }
 
 /* The box of the band's points in its plane: frame e1, e2, box = u0, u1, v0,
@@ -280,18 +289,13 @@ slab_plane_build(const double* xyz,
 {
   dacpo_tangent_frame(dir, sp->e1, sp->e2);
   size_t m = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    m += y >= lo - width && y <= lo + 2.0 * width &&
-         fabs(dot3(dir, axes + 3 * i)) > LAYERED_COS;
-  }
+  for (size_t i = 0; i < n; ++i)
+    m += in_slab(dir, lo, width, xyz + 3 * i, axes + 3 * i);
   double* uv = dacpo_malloc_array(3 * m, sizeof(double));
   sp->index = dacpo_malloc_array(m, sizeof(size_t));
   dacpo_status st = uv && sp->index ? DACPO_OK : DACPO_OOM(err);
   for (size_t i = 0, t = 0; i < n && st == DACPO_OK; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y < lo - width || y > lo + 2.0 * width ||
-        fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+    if (!in_slab(dir, lo, width, xyz + 3 * i, axes + 3 * i))
       continue;
     uv[3 * t] = dot3(sp->e1, xyz + 3 * i);
     uv[3 * t + 1] = dot3(sp->e2, xyz + 3 * i);
