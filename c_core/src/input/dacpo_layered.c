@@ -131,35 +131,41 @@ local_spacing(const float* sqd, size_t k, size_t i)
   return got ? sum / (double)got : 0.0;
 }
 
-/* 1 if point i has a second parallel sheet among its neighbours. */
+/* 1 if point i has a second parallel sheet among the m candidates cand
+ * (cloud indices; negative ones and i itself are skipped): stage 2's two-sheet
+ * pair test, its window two local spacings (window 0: the larger of the two
+ * points' own) or, given, two windows. idx, sqd, k: the k-NN rows the local
+ * noise and spacing are read from. */
 static int
-has_second_sheet(const double* xyz,
-                 const double* axes,
-                 const int32_t* idx,
-                 const float* sqd,
-                 size_t k,
-                 size_t i,
-                 double spacing)
+sheet_among(const double* xyz,
+            const double* axes,
+            const int32_t* idx,
+            const float* sqd,
+            size_t k,
+            size_t i,
+            const int32_t* cand,
+            size_t m,
+            double window,
+            double spacing)
 {
   const double* p = xyz + 3 * i;
   const double* a = axes + 3 * i;
   const double noise_i = local_noise(xyz, axes, idx, k, i);
   const double local_i = local_spacing(sqd, k, i);
   size_t pairs = 0;
-  for (size_t t = 0; t < k && pairs < LAYERED_PAIRS; ++t) {
-    if (idx[i * k + t] < 0)
+  for (size_t t = 0; t < m && pairs < LAYERED_PAIRS; ++t) {
+    if (cand[t] < 0 || (size_t)cand[t] == i)
       continue;
-    const size_t j = (size_t)idx[i * k + t];
-    if (j == i)
-      continue;
-    pairs += dacpo_two_sheet_pair(p,
-                                  a,
-                                  xyz + 3 * j,
-                                  axes + 3 * j,
-                                  fmax(noise_i, local_noise(xyz, axes, idx, k, j)),
-                                  fmax(local_i, local_spacing(sqd, k, j)),
-                                  LAYERED_PAIR_NOISE,
-                                  spacing);
+    const size_t j = (size_t)cand[t];
+    pairs += dacpo_two_sheet_pair(
+        p,
+        a,
+        xyz + 3 * j,
+        axes + 3 * j,
+        fmax(noise_i, local_noise(xyz, axes, idx, k, j)),
+        window > 0.0 ? window : fmax(local_i, local_spacing(sqd, k, j)),
+        LAYERED_PAIR_NOISE,
+        spacing);
   }
   return pairs >= LAYERED_PAIRS;
 }
@@ -316,6 +322,7 @@ static int
 has_sheet_in_slab(const double* xyz,
                   const double* axes,
                   const int32_t* idx,
+                  const float* sqd,
                   size_t k,
                   const slab_plane* sp,
                   size_t i,
@@ -327,21 +334,9 @@ has_sheet_in_slab(const double* xyz,
   int32_t nb[LAYERED_K + 1];
   double d2[LAYERED_K + 1];
   const size_t got = dacpo_kdtree_knn(sp->tree, q, LAYERED_K + 1, nb, d2);
-  const double noise_i = local_noise(xyz, axes, idx, k, i);
-  size_t pairs = 0;
-  for (size_t t = 0; t < got && pairs < LAYERED_PAIRS; ++t) {
-    const size_t j = sp->index[nb[t]];
-    if (j != i)
-      pairs += dacpo_two_sheet_pair(p,
-                                    axes + 3 * i,
-                                    xyz + 3 * j,
-                                    axes + 3 * j,
-                                    fmax(noise_i, local_noise(xyz, axes, idx, k, j)),
-                                    width,
-                                    LAYERED_PAIR_NOISE,
-                                    spacing);
-  }
-  return pairs >= LAYERED_PAIRS;
+  for (size_t t = 0; t < got; ++t)
+    nb[t] = (int32_t)sp->index[nb[t]];
+  return sheet_among(xyz, axes, idx, sqd, k, i, nb, got, width, spacing);
 }
 
 /* The surface itself: the densest slab one spacing thick within the band
@@ -407,13 +402,22 @@ copy_rates(const double* xyz,
       on_surface < DACPO_LAYERED_SAMPLE ? on_surface : DACPO_LAYERED_SAMPLE;
   size_t seen = 0, taken = 0, copies = 0, stacked = 0;
   for (size_t i = 0; i < n && taken < s && st == DACPO_OK; ++i) {
-    const double yi = dot3(dir, xyz + 3 * i);
-    if (yi < at || yi > at + spacing || fabs(dot3(dir, axes + 3 * i)) <= LAYERED_COS)
+    if (!in_band(dir, at, spacing, xyz + 3 * i, axes + 3 * i))
       continue;
     if (seen++ * s >= taken * on_surface) {
       taken++;
-      copies += has_second_sheet(xyz, axes, knn_idx, knn_sqd, knn_k, i, spacing);
-      stacked += has_sheet_in_slab(xyz, axes, knn_idx, knn_k, &sp, i, width, spacing);
+      copies += sheet_among(xyz,
+                            axes,
+                            knn_idx,
+                            knn_sqd,
+                            knn_k,
+                            i,
+                            knn_idx + i * knn_k,
+                            knn_k,
+                            0.0,
+                            spacing);
+      stacked +=
+          has_sheet_in_slab(xyz, axes, knn_idx, knn_sqd, knn_k, &sp, i, width, spacing);
     }
   }
   dacpo_kdtree_free(sp.tree);
@@ -421,6 +425,13 @@ copy_rates(const double* xyz,
   *rate = taken ? (double)copies / (double)taken : 0.0;
   *doubled = taken ? (double)stacked / (double)taken : 0.0;
   return st;
+}
+
+/* The cell of (u, v) in a grid of nv cells per row over box (u0, u1, v0, v1). */
+static size_t
+footprint_cell(double u, double v, const double box[4], double cell, size_t nv)
+{
+  return (size_t)((u - box[0]) / cell) * nv + (size_t)((v - box[2]) / cell);
 }
 
 /* The points beyond the slab [lo - width, lo + 2 width] along dir on the side
@@ -448,21 +459,18 @@ minority_under_band(const double* xyz,
   unsigned char* under = calloc(nu * nv, 1);
   if (!under)
     return DACPO_OOM(err);
+  for (size_t i = 0; i < n; ++i) /* band points lie in the box by construction */
+    if (in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i))
+      under[footprint_cell(
+          dot3(e1, xyz + 3 * i), dot3(e2, xyz + 3 * i), box, cell, nv)] = 1;
   *count = 0;
-  for (int pass = 0; pass < 2; ++pass)
-    for (size_t i = 0; i < n; ++i) {
-      const double y = dot3(dir, xyz + 3 * i);
-      const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
-      const int band = in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
-      const int beyond = below ? y < lo - width : y > lo + 2.0 * width;
-      if (!(pass == 0 ? band : beyond) || u < u0 || u > u1 || v < v0 || v > v1)
-        continue;
-      const size_t c = (size_t)((u - u0) / cell) * nv + (size_t)((v - v0) / cell);
-      if (pass == 0)
-        under[c] = 1;
-      else
-        *count += under[c];
-    }
+  for (size_t i = 0; i < n; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
+    if ((below ? y < lo - width : y > lo + 2.0 * width) && u >= u0 && u <= u1 &&
+        v >= v0 && v <= v1)
+      *count += under[footprint_cell(u, v, box, cell, nv)];
+  }
   free(under);
   return DACPO_OK;
 }
