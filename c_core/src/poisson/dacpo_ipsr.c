@@ -42,11 +42,14 @@
  * and screening.
  *
  * Cost per iteration: one warm-started multigrid-CG solve (O(band cells)),
- * one marching-cubes pass, one k-NN query per face. Failure modes:
+ * one marching-cubes pass, the k nearest samples of every face (from the
+ * candidate lists of dacpo_cell_knn.c, kept per grid cell for the block's
+ * iterations: the kd-tree's answer at a fraction of its cost). Failure modes:
  * INVALID_ARGUMENT (bad params, n_own > n), NONFINITE_INPUT, OUT_OF_MEMORY.
  */
 #include "dacpo_ipsr.h"
 
+#include "dacpo_cell_knn.h"
 #include "dacpo_kdtree.h"
 #include "dacpo_mcubes.h"
 #include "dacpo_poisson.h"
@@ -82,6 +85,7 @@ dacpo_ipsr_params_default(dacpo_ipsr_params* p)
 /* Scratch of one block run; every array is freed by ipsr_clear. */
 typedef struct ipsr_work {
   dacpo_kdtree* tree;
+  dacpo_cell_knn* faces_knn; /* the face queries, through tree */
   dacpo_poisson* ps;
   dacpo_mcubes* mc;
   double* area;   /* n */
@@ -105,6 +109,7 @@ typedef struct ipsr_work {
 static void
 ipsr_clear(ipsr_work* w)
 {
+  dacpo_cell_knn_free(w->faces_knn);
   dacpo_kdtree_free(w->tree);
   dacpo_poisson_free(w->ps);
   dacpo_mcubes_free(w->mc);
@@ -129,7 +134,7 @@ work_bytes(const ipsr_work* w, size_t k)
          w->fcap *
              (k * sizeof(int32_t) + 4 * sizeof(double) + 1 + 4 * sizeof(int32_t)) +
          (w->vcap + 1) * sizeof(int32_t) + dacpo_poisson_bytes(w->ps) +
-         dacpo_mcubes_bytes(w->mc);
+         dacpo_mcubes_bytes(w->mc) + dacpo_cell_knn_bytes(w->faces_knn);
 }
 
 static int
@@ -344,7 +349,7 @@ query_faces(ipsr_work* w, const dacpo_mesh* m, size_t k)
     nf[0] = e1[1] * e2[2] - e1[2] * e2[1];
     nf[1] = e1[2] * e2[0] - e1[0] * e2[2];
     nf[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    size_t got = dacpo_kdtree_knn(w->tree, c, k, w->fknn + k * f, d2);
+    size_t got = dacpo_cell_knn_query(w->faces_knn, c, w->fknn + k * f, d2);
     for (size_t j = got; j < k; ++j)
       w->fknn[k * f + j] = -1;
     w->fdist2[f] = got ? d2[0] : HUGE_VAL;
@@ -759,6 +764,10 @@ dacpo_ipsr_block(const double* xyz,
 
   if ((status = ipsr_setup(&w, xyz, n, spacing, params, st, err)) != DACPO_OK)
     goto done;
+  status = dacpo_cell_knn_create(
+      w.tree, xyz, n, dacpo_poisson_grid(w.ps), run.k, &w.faces_knn, err);
+  if (status != DACPO_OK)
+    goto done;
   const double far = params->trim_spacings * spacing;
   run.far2 = far * far;
   if ((status = ipsr_iterate(&w, &run, params, nrm, old, st, err)) != DACPO_OK)
@@ -784,3 +793,4 @@ done:
   st->seconds = dacpo_now() - t_start;
   return status;
 }
+
