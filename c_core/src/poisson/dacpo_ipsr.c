@@ -18,8 +18,8 @@
  * Wings: the Neumann surface runs on from the data's rim to the border of the
  * Poisson domain ("extended faces", paper Fig. 4): the box for band 0, a few
  * cells past the data for the default narrow band. They are kept in early
- * iterations and trimmed from iteration trim_start on (and always once the
- * normals have settled, so the final iterations see a trimmed mesh): faces
+ * iterations and trimmed from iteration trim_start on (a run that settles
+ * earlier stops there; the mesh it hands out is trimmed all the same): faces
  * farther than trim_spacings sample spacings from every sample are removed
  * when a chain of such far faces links them to the mesh rim (its boundary
  * edges, which lie on the domain's border), so gaps inside the data stay
@@ -674,12 +674,8 @@ ipsr_iterate(ipsr_work* w,
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);
     st->final_change = metric;
     if (metric < params->convergence) {
-      if (trimming) {
-        st->converged = 1;
-        break;
-      }
-      /* Settled with the wings on: refine the rim once more without them. */
-      trimming = 1;
+      st->converged = 1;
+      break;
     }
   }
   return DACPO_OK;
