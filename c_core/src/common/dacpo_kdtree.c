@@ -188,28 +188,12 @@ typedef struct kd_result {
   double* d;
 } kd_result;
 
-/* Sorted insertion by (distance, index); k is small (tens), so shifting beats
- * a heap and leaves the output already ordered. */
-static void
+/* Insertion into r (dacpo_nearest_insert): k is small (tens), so shifting
+ * beats a heap and leaves the output already ordered. */
+static inline void
 kd_push(kd_result* r, double d, int32_t id)
 {
-  size_t pos;
-  if (r->count < r->k) {
-    pos = r->count++;
-  }
-  else {
-    pos = r->k - 1;
-    if (d > r->d[pos] || (d == r->d[pos] && id > r->idx[pos]))
-      return;
-  }
-  while (pos > 0 &&
-         (r->d[pos - 1] > d || (r->d[pos - 1] == d && r->idx[pos - 1] > id))) {
-    r->d[pos] = r->d[pos - 1];
-    r->idx[pos] = r->idx[pos - 1];
-    --pos;
-  }
-  r->d[pos] = d;
-  r->idx[pos] = id;
+  dacpo_nearest_insert(r->idx, r->d, r->k, &r->count, id, d);
 }
 
 /* A subtree left for later: its node and the per-axis offsets (off[d] is a

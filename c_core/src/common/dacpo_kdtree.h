@@ -15,6 +15,31 @@ dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* e
 void
 dacpo_kdtree_free(dacpo_kdtree* tree);
 
+/* Sorted insertion of (dist, id) into an answer of capacity k holding *count
+ * entries, ordered by (squared distance, index) as every nearest-neighbour
+ * answer of the core is; a candidate beyond a full answer is dropped. */
+static inline void
+dacpo_nearest_insert(
+    int32_t* idx, double* d, size_t k, size_t* count, int32_t id, double dist)
+{
+  size_t pos;
+  if (*count == k) {
+    if (dist > d[k - 1] || (dist == d[k - 1] && id > idx[k - 1]))
+      return;
+    pos = k - 1;
+  }
+  else {
+    pos = (*count)++;
+  }
+  while (pos > 0 && (d[pos - 1] > dist || (d[pos - 1] == dist && idx[pos - 1] > id))) {
+    d[pos] = d[pos - 1];
+    idx[pos] = idx[pos - 1];
+    --pos;
+  }
+  d[pos] = dist;
+  idx[pos] = id;
+}
+
 /* Up to k nearest points of q, nearest first (ties: lower index first); writes
  * indices and squared distances, returns how many were written (min(k, n)).
  * Read-only on the tree: safe to call from several threads at once. */

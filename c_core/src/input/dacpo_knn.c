@@ -40,28 +40,6 @@ typedef struct knn_job {
   dacpo_knn_graph* out;
 } knn_job;
 
-/* Sorted insertion by (distance, index) into a row of capacity k. */
-static void
-row_push(int32_t* idx, double* d, size_t k, size_t* count, int32_t id, double dist)
-{
-  size_t pos;
-  if (*count == k) {
-    if (dist > d[k - 1] || (dist == d[k - 1] && id > idx[k - 1]))
-      return;
-    pos = k - 1;
-  }
-  else {
-    pos = (*count)++;
-  }
-  while (pos > 0 && (d[pos - 1] > dist || (d[pos - 1] == dist && idx[pos - 1] > id))) {
-    d[pos] = d[pos - 1];
-    idx[pos] = idx[pos - 1];
-    --pos;
-  }
-  d[pos] = dist;
-  idx[pos] = id;
-}
-
 static void
 write_row(
     dacpo_knn_graph* g, size_t i, const int32_t* idx, const double* d, size_t count)
@@ -186,7 +164,7 @@ knn_callback_point(const knn_job* job,
         continue;
       const double* x = c->xyz + 3 * (size_t)p;
       double dx = q[0] - x[0], dy = q[1] - x[1], dz = q[2] - x[2];
-      row_push(row_idx, row_d, k, &count, p, dx * dx + dy * dy + dz * dz);
+      dacpo_nearest_insert(row_idx, row_d, k, &count, p, dx * dx + dy * dy + dz * dz);
     }
     /* Done when full, when the search has no more to give, or when it was
      * already asked for everything. */

@@ -180,24 +180,8 @@ nearest_in_list(const dacpo_tree_point* p,
     dd[i] = dx * dx + dy * dy + dz * dz;
   }
   size_t have = 0;
-  for (size_t i = 0; i < count; ++i) {
-    const double d = dd[i];
-    const int32_t id = p[i].id;
-    size_t pos;
-    if (have < k)
-      pos = have++;
-    else if (d < d2[k - 1] || (d == d2[k - 1] && id < idx[k - 1]))
-      pos = k - 1;
-    else
-      continue;
-    while (pos > 0 && (d2[pos - 1] > d || (d2[pos - 1] == d && idx[pos - 1] > id))) {
-      d2[pos] = d2[pos - 1];
-      idx[pos] = idx[pos - 1];
-      --pos;
-    }
-    d2[pos] = d;
-    idx[pos] = id;
-  }
+  for (size_t i = 0; i < count; ++i)
+    dacpo_nearest_insert(idx, d2, k, &have, p[i].id, dd[i]);
   return have;
 }
 
