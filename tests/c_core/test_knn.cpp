@@ -290,37 +290,43 @@ TEST(DacpoKnn, ProgressCanCancel)
 
 TEST(DacpoKnn, AdjacencyIsTheSymmetrizedGraph)
 {
-  auto xyz = randomCloud(3000, 8);
+  // 10,000 points: three chunks of rows, so 2 and 3 threads sort rows apart
+  const size_t n = 10000;
+  auto xyz = randomCloud(n, 8);
   Cloud cl(xyz);
   Graph g;
   dacpo_err err{};
   ASSERT_EQ(dacpo_knn_build(&cl.c, 10, nullptr, 2, nullptr, &g.g, &err), DACPO_OK);
   for (size_t k_use : {size_t(10), size_t(4)}) {
-    std::vector<std::set<int32_t>> ref(3000);
-    for (size_t i = 0; i < 3000; ++i)
+    std::vector<std::set<int32_t>> ref(n);
+    for (size_t i = 0; i < n; ++i)
       for (size_t r = 0; r < k_use; ++r) {
         int32_t j = g.g.idx[i * 10 + r];
         ref[i].insert(j);
         ref[j].insert(static_cast<int32_t>(i));
       }
-    dacpo_adjacency a{};
-    ASSERT_EQ(dacpo_adjacency_build(&g.g, k_use, &a, &err), DACPO_OK);
-    ASSERT_EQ(a.n, 3000u);
-    EXPECT_EQ(a.start[0], 0u);
-    size_t asym = 0;
-    for (size_t i = 0; i < 3000; ++i) {
-      std::vector<int32_t> row(a.nbr + a.start[i], a.nbr + a.start[i + 1]);
-      ASSERT_EQ(row, std::vector<int32_t>(ref[i].begin(), ref[i].end())) << "row " << i;
-      for (int32_t j : row) {
-        EXPECT_NE(j, static_cast<int32_t>(i));
-        EXPECT_TRUE(std::binary_search(
-            a.nbr + a.start[j], a.nbr + a.start[j + 1], static_cast<int32_t>(i)));
+    for (unsigned threads : {1u, 2u, 3u}) {
+      dacpo_adjacency a{};
+      ASSERT_EQ(dacpo_adjacency_build_threads(&g.g, k_use, threads, &a, &err),
+                DACPO_OK);
+      ASSERT_EQ(a.n, n);
+      EXPECT_EQ(a.start[0], 0u);
+      size_t asym = 0;
+      for (size_t i = 0; i < n; ++i) {
+        std::vector<int32_t> row(a.nbr + a.start[i], a.nbr + a.start[i + 1]);
+        ASSERT_EQ(row, std::vector<int32_t>(ref[i].begin(), ref[i].end()))
+            << "row " << i << ", " << threads << " threads";
+        for (int32_t j : row) {
+          EXPECT_NE(j, static_cast<int32_t>(i));
+          EXPECT_TRUE(std::binary_search(
+              a.nbr + a.start[j], a.nbr + a.start[j + 1], static_cast<int32_t>(i)));
+        }
+        asym += row.size() > k_use;
       }
-      asym += row.size() > k_use;
+      EXPECT_GT(asym, 0u); // symmetrization added edges somewhere
+      dacpo_adjacency_free(&a);
+      EXPECT_EQ(a.start, nullptr);
     }
-    EXPECT_GT(asym, 0u); // symmetrization added edges somewhere
-    dacpo_adjacency_free(&a);
-    EXPECT_EQ(a.start, nullptr);
   }
 }
 

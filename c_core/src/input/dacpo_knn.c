@@ -370,23 +370,54 @@ adj_fill_rows(const dacpo_knn_graph* g,
   }
 }
 
-/* Sorts each row, drops repeats (mutual neighbours appear twice), compacts. */
-static void
-adj_sort_unique_rows(dacpo_adjacency* out)
+/* Rows [task * KNN_CHUNK, ...) sorted in place, repeats (mutual neighbours
+ * appear twice) dropped; each row's length left in len. */
+typedef struct adj_sort_job {
+  dacpo_adjacency* out;
+  size_t* len;
+} adj_sort_job;
+
+static dacpo_status
+adj_sort_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
 {
-  size_t n = out->n;
-  size_t w = 0;
-  size_t row_begin = 0;
-  for (size_t i = 0; i < n; ++i) {
-    size_t row_end = out->start[i + 1];
-    int32_t* r = out->nbr + row_begin;
-    size_t m = row_end - row_begin;
+  adj_sort_job* job = (adj_sort_job*)user;
+  const size_t n = job->out->n, begin = task * KNN_CHUNK;
+  const size_t end = begin + KNN_CHUNK < n ? begin + KNN_CHUNK : n;
+  for (size_t i = begin; i < end; ++i) {
+    int32_t* r = job->out->nbr + job->out->start[i];
+    const size_t m = job->out->start[i + 1] - job->out->start[i];
     sort_row(r, m);
-    out->start[i] = w;
+    size_t w = 0;
     for (size_t j = 0; j < m; ++j)
-      if (j == 0 || r[j] != r[j - 1])
-        out->nbr[w++] = r[j];
-    row_begin = row_end;
+      if (j == 0 || r[j] != r[w - 1])
+        r[w++] = r[j];
+    job->len[i] = w;
+  }
+  return DACPO_OK;
+}
+
+/* Sorts the rows (in parallel), then compacts them into place. len: n scratch. */
+static dacpo_status
+adj_sort_unique_rows(dacpo_adjacency* out,
+                     size_t* len,
+                     unsigned threads,
+                     dacpo_err* err)
+{
+  const size_t n = out->n;
+  adj_sort_job job = {out, len};
+  DACPO_TRY(dacpo_parallel_for((n + KNN_CHUNK - 1) / KNN_CHUNK,
+                               threads,
+                               adj_sort_task,
+                               &job,
+                               NULL,
+                               DACPO_STAGE_NEIGHBORS,
+                               err));
+  size_t w = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t from = out->start[i];
+    out->start[i] = w;
+    memmove(out->nbr + w, out->nbr + from, len[i] * sizeof(int32_t));
+    w += len[i];
   }
   out->start[n] = w;
   if (w > 0) {
@@ -394,6 +425,7 @@ adj_sort_unique_rows(dacpo_adjacency* out)
     if (shrunk)
       out->nbr = shrunk;
   }
+  return DACPO_OK;
 }
 
 dacpo_status
@@ -401,6 +433,16 @@ dacpo_adjacency_build(const dacpo_knn_graph* g,
                       size_t k_use,
                       dacpo_adjacency* out,
                       dacpo_err* err)
+{
+  return dacpo_adjacency_build_threads(g, k_use, 1, out, err);
+}
+
+dacpo_status
+dacpo_adjacency_build_threads(const dacpo_knn_graph* g,
+                              size_t k_use,
+                              unsigned num_threads,
+                              dacpo_adjacency* out,
+                              dacpo_err* err)
 {
   DACPO_CHECK(err, out != NULL, DACPO_ERR_INVALID_ARGUMENT, "adjacency: out is NULL");
   memset(out, 0, sizeof(*out));
@@ -435,9 +477,12 @@ dacpo_adjacency_build(const dacpo_knn_graph* g,
     return DACPO_OOM(err);
   }
   adj_fill_rows(g, k_use, out, fill);
+  /* fill is done with: it holds the row lengths after the sort */
+  dacpo_status st = adj_sort_unique_rows(out, fill, num_threads, err);
   free(fill);
-  adj_sort_unique_rows(out);
-  return DACPO_OK;
+  if (st != DACPO_OK)
+    dacpo_adjacency_free(out);
+  return st;
 }
 
 void

@@ -53,6 +53,15 @@ dacpo_adjacency_build(const dacpo_knn_graph* g,
                       dacpo_adjacency* out,
                       dacpo_err* err);
 
+/* The same adjacency, its rows sorted on num_threads threads (0 = all cores);
+ * the result does not depend on the thread count. */
+dacpo_status
+dacpo_adjacency_build_threads(const dacpo_knn_graph* g,
+                              size_t k_use,
+                              unsigned num_threads,
+                              dacpo_adjacency* out,
+                              dacpo_err* err);
+
 void
 dacpo_adjacency_free(dacpo_adjacency* a);
 

@@ -21,6 +21,7 @@
 #include "dacpo_ipsr.h"
 #include "dacpo_job_internal.h"
 #include "dacpo_knn.h"
+#include "dacpo_layered.h"
 #include "dacpo_normals.h"
 #include "dacpo_parallel.h"
 #include "dacpo_part_sign.h"
@@ -28,7 +29,6 @@
 #include "dacpo_segment.h"
 #include "dacpo_sign_passes.h"
 #include "dacpo_surface_vote.h"
-#include "dacpo_layered.h"
 #include "dacpo_vcr.h"
 #include "dacpo_view_kind.h"
 
@@ -113,7 +113,8 @@ build_neighbors(run_state* s,
   }
   DACPO_TRY(dacpo_knn_build(
       &s->cloud, kmax, search, s->p.num_threads, s->progress, &s->knn, err));
-  DACPO_TRY(dacpo_adjacency_build(&s->knn, st->k_used, &s->adj, err));
+  DACPO_TRY(dacpo_adjacency_build_threads(
+      &s->knn, st->k_used, s->p.num_threads, &s->adj, err));
   s->component = dacpo_malloc_array(n, sizeof(int32_t));
   if (!s->component)
     return DACPO_OOM(err);
@@ -578,8 +579,14 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->layered_doubled = 0.0;
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
     double fit = 0.0, slope = 0.0;
-    DACPO_TRY(dacpo_single_view_fit(
-        s->cloud.xyz, s->cloud.nrm, s->cloud.n, s->knn.sqd, s->knn.k, &fit, &slope, err));
+    DACPO_TRY(dacpo_single_view_fit(s->cloud.xyz,
+                                    s->cloud.nrm,
+                                    s->cloud.n,
+                                    s->knn.sqd,
+                                    s->knn.k,
+                                    &fit,
+                                    &slope,
+                                    err));
     st->single_view_fit = fit;
     s->p.scan_kind =
         fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
@@ -807,7 +814,6 @@ dacpo_job_weigh_edges(dacpo_job* job)
     status = weigh_edges(&job->s, &err);
   return status == DACPO_OK ? DACPO_OK : job_fail(job->ctx, status, &err);
 }
-
 
 /* Stages 5-6 and the parts. */
 static dacpo_status
