@@ -264,3 +264,50 @@ TEST(DacpoKdtree, SampleAreaOnAGridIsPiSpacingSquaredOverFour)
   EXPECT_EQ(dacpo_kdtree_sample_area(tree, two), 0.0);
   dacpo_kdtree_free(tree);
 }
+
+// The lower levels are built as tasks: the tree (its point order, hence its
+// answers) is the same on 1, 2 or 3 threads, and matches the brute force.
+// 60,000 points reach the task depth (32 subtrees); 20,000 of them coincide
+// in pairs, and a flat slab makes one axis degenerate.
+TEST(DacpoKdtree, TheTreeDoesNotDependOnTheThreads)
+{
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> xyz;
+  for (int i = 0; i < 40000; ++i)
+    xyz.insert(xyz.end(), {u(rng), u(rng), 0.001 * u(rng)});
+  for (int i = 0; i < 10000; ++i)
+    for (int rep = 0; rep < 2; ++rep)
+      xyz.insert(xyz.end(), {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
+  const size_t n = xyz.size() / 3;
+  std::vector<int32_t> order1;
+  for (unsigned threads : {1u, 2u, 3u}) {
+    dacpo_kdtree* t = nullptr;
+    dacpo_err err{};
+    ASSERT_EQ(dacpo_kdtree_build_threads(xyz.data(), n, threads, &t, &err), DACPO_OK)
+        << err.msg;
+    std::vector<int32_t> order(n);
+    for (size_t pos = 0; pos < n; ++pos)
+      order[pos] = dacpo_kdtree_order_at(t, pos);
+    if (threads == 1)
+      order1 = order;
+    else
+      EXPECT_EQ(order, order1) << threads << " threads";
+    std::vector<int32_t> idx(12);
+    std::vector<double> d(12);
+    for (size_t s = 0; s < n; s += 997) {
+      const double* q = xyz.data() + 3 * s;
+      auto expect = bruteForce(xyz, q, 12);
+      ASSERT_EQ(dacpo_kdtree_knn(t, q, 12, idx.data(), d.data()), 12u);
+      for (size_t j = 0; j < 12; ++j) {
+        ASSERT_EQ(idx[j], expect[j].second) << "query " << s << " rank " << j;
+        ASSERT_EQ(d[j], expect[j].first);
+      }
+    }
+    dacpo_kdtree_free(t);
+  }
+  std::vector<int32_t> sorted = order1;
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t i = 0; i < n; ++i)
+    ASSERT_EQ(sorted[i], static_cast<int32_t>(i)); // every point once
+}

@@ -10,8 +10,11 @@
  *         dacpo_select.h) along the
  *         widest axis of the node's bounding box, until a node holds at most
  *         KD_LEAF points. Splitting by count keeps the depth at about log2(n/8)
- *         even when all points coincide. O(n log n) time, no extra memory
- *         beyond the copy and the node array.
+ *         even when all points coincide, and fixes every subtree's size and
+ *         node range in advance, so the subtrees below the top KD_TASK_DEPTH
+ *         levels are built as parallel tasks into their own ranges (the same
+ *         tree on any thread count). O(n log n) time, no extra memory beyond
+ *         the copy and the node array.
  * Query:  depth-first, near child first; a far child is visited only if the
  *         lower bound of its distance (per-axis offsets to the child's extent,
  *         as in Arya & Mount's incremental distance) does not exceed the current
@@ -23,6 +26,7 @@
  * Queries never allocate and are safe from several threads at once. */
 #include "dacpo_kdtree.h"
 
+#include "dacpo_parallel.h"
 #include "dacpo_select.h"
 
 #include <math.h>
@@ -55,18 +59,62 @@ struct dacpo_kdtree {
 
 /* ---- build ------------------------------------------------------------- */
 
+/* Subtrees below this depth are built as separate tasks (up to 2^KD_TASK_DEPTH
+ * of them), each with its own pivot stream, whatever the thread count: the
+ * tree is the same on 1 or 16 threads. */
+enum { KD_TASK_DEPTH = 5 };
+
+/* A subtree left for a task: its node, points, depth and the first index of
+ * its descendants. */
+typedef struct kd_task {
+  size_t node, begin, end, depth, next;
+} kd_task;
+
 typedef struct kd_build {
   dacpo_tree_point* pts; /* permuted into tree order by the build */
   kd_node* nodes;
-  size_t num_nodes;
-  size_t cap_nodes;
   dacpo_rng rng; /* pivot choice only; fixed seed keeps builds identical */
   size_t max_depth;
+  kd_task* tasks; /* NULL: build every level here */
+  size_t num_tasks;
 } kd_build;
 
-/* Recursion depth is the tree depth, about log2(n / KD_LEAF) <= 28. */
+/* Nodes below a node of m points (splits by count: floor(m/2), ceil(m/2)),
+ * for m and m + 1 at once: each level needs two neighbouring sizes only. */
 static void
-kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
+kd_descendants(size_t m, size_t* dm, size_t* dm1)
+{
+  if (m + 1 <= KD_LEAF) {
+    *dm = *dm1 = 0;
+    return;
+  }
+  size_t a, b; /* D(h), D(h + 1) with h = m / 2 */
+  kd_descendants(m / 2, &a, &b);
+  if (m % 2 == 0) {
+    *dm = m <= KD_LEAF ? 0 : 2 + 2 * a;
+    *dm1 = 2 + a + b;
+  }
+  else {
+    *dm = m <= KD_LEAF ? 0 : 2 + a + b;
+    *dm1 = 2 + 2 * b;
+  }
+}
+
+static size_t
+kd_subtree_nodes(size_t m)
+{
+  size_t d, d1;
+  kd_descendants(m, &d, &d1);
+  return d;
+}
+
+/* Node `node` over points [begin, end); its children go to next and next + 1,
+ * the left child's descendants from next + 2, the right child's after them
+ * (the layout of a depth-first build). Recursion depth is the tree depth,
+ * about log2(n / KD_LEAF) <= 28. */
+static void
+kd_build_node(
+    kd_build* b, size_t node, size_t begin, size_t end, size_t depth, size_t next)
 {
   kd_node* nd = &b->nodes[node];
   if (depth > b->max_depth)
@@ -76,9 +124,12 @@ kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
   nd->child = -1;
   nd->dim = 0;
   nd->low_max = nd->high_min = 0.0;
-  /* (the node bound is proven in dacpo_kdtree_build; the check costs nothing) */
-  if (end - begin <= KD_LEAF || b->num_nodes + 2 > b->cap_nodes)
+  if (end - begin <= KD_LEAF)
     return;
+  if (b->tasks && depth == KD_TASK_DEPTH) {
+    b->tasks[b->num_tasks++] = (kd_task){node, begin, end, depth, next};
+    return;
+  }
 
   const dacpo_tree_point* p = b->pts;
   double lo[3], hi[3];
@@ -105,18 +156,60 @@ kd_build_node(kd_build* b, size_t node, size_t begin, size_t end, size_t depth)
     if (p[i].x[dim] > low_max)
       low_max = p[i].x[dim];
 
-  size_t child = b->num_nodes;
-  b->num_nodes += 2;
-  nd->child = (int32_t)child;
+  nd->child = (int32_t)next;
   nd->dim = dim;
   nd->low_max = low_max;
   nd->high_min = p[mid].x[dim];
-  kd_build_node(b, child, begin, mid, depth + 1);
-  kd_build_node(b, child + 1, mid, end, depth + 1);
+  kd_build_node(b, next, begin, mid, depth + 1, next + 2);
+  kd_build_node(
+      b, next + 1, mid, end, depth + 1, next + 2 + kd_subtree_nodes(mid - begin));
+}
+
+/* One subtree left by the top levels, with a pivot stream of its own. */
+static dacpo_status
+kd_task_run(void* user, size_t task, unsigned thread_id, dacpo_err* err)
+{
+  kd_build* top = (kd_build*)user;
+  const kd_task* t = &top->tasks[task];
+  kd_build b = {top->pts, top->nodes, {{0}}, 0, NULL, 0};
+  dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 1 + t->node);
+  kd_build_node(&b, t->node, t->begin, t->end, t->depth, t->next);
+  /* the depth reached, kept in the task for the caller */
+  top->tasks[task].depth = b.max_depth;
+  return DACPO_OK;
+}
+
+/* The top KD_TASK_DEPTH levels here, the subtrees below them on num_threads
+ * threads; *max_depth gets the tree's depth. */
+static dacpo_status
+kd_build_all(dacpo_kdtree* t, unsigned num_threads, size_t* max_depth, dacpo_err* err)
+{
+  kd_task tasks[(size_t)1 << KD_TASK_DEPTH];
+  kd_build b = {t->pts, t->nodes, {{0}}, 0, tasks, 0};
+  dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 0);
+  kd_build_node(&b, 0, 0, t->n, 0, 1);
+  t->num_nodes = 1 + kd_subtree_nodes(t->n);
+  DACPO_TRY(dacpo_parallel_for(
+      b.num_tasks, num_threads, kd_task_run, &b, NULL, DACPO_STAGE_NEIGHBORS, err));
+  *max_depth = b.max_depth;
+  for (size_t i = 0; i < b.num_tasks; ++i)
+    if (tasks[i].depth > *max_depth)
+      *max_depth = tasks[i].depth;
+  return DACPO_OK;
 }
 
 dacpo_status
 dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* err)
+{
+  return dacpo_kdtree_build_threads(xyz, n, 1, out, err);
+}
+
+dacpo_status
+dacpo_kdtree_build_threads(const double* xyz,
+                           size_t n,
+                           unsigned num_threads,
+                           dacpo_kdtree** out,
+                           dacpo_err* err)
 {
   DACPO_CHECK(err, out != NULL, DACPO_ERR_INVALID_ARGUMENT, "kdtree: out is NULL");
   *out = NULL;
@@ -151,17 +244,20 @@ dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* e
   dacpo_tree_points_fill(t->pts, xyz, NULL, n);
 
   if (n > 0) {
-    kd_build b = {t->pts, t->nodes, 1, cap, {{0}}, 0};
-    dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 0);
-    kd_build_node(&b, 0, 0, n, 0);
-    t->num_nodes = b.num_nodes;
-    if (b.max_depth >= KD_MAX_DEPTH) {
+    size_t depth = 0;
+    dacpo_status st =
+        1 + kd_subtree_nodes(n) <= cap
+            ? kd_build_all(t, num_threads, &depth, err)
+            : dacpo_err_set(err, DACPO_ERR_INTERNAL, "kdtree: node bound");
+    if (st == DACPO_OK && depth >= KD_MAX_DEPTH)
+      st = dacpo_err_set(err,
+                         DACPO_ERR_INTERNAL,
+                         "kdtree: depth %zu exceeds %d",
+                         depth,
+                         (int)KD_MAX_DEPTH);
+    if (st != DACPO_OK) {
       dacpo_kdtree_free(t);
-      return dacpo_err_set(err,
-                           DACPO_ERR_INTERNAL,
-                           "kdtree: depth %zu exceeds %d",
-                           b.max_depth,
-                           (int)KD_MAX_DEPTH);
+      return st;
     }
   }
   *out = t;

@@ -12,6 +12,15 @@ typedef struct dacpo_kdtree dacpo_kdtree;
 dacpo_status
 dacpo_kdtree_build(const double* xyz, size_t n, dacpo_kdtree** out, dacpo_err* err);
 
+/* The same tree, its lower levels built on num_threads threads (0 = all
+ * cores); the tree does not depend on the thread count. */
+dacpo_status
+dacpo_kdtree_build_threads(const double* xyz,
+                           size_t n,
+                           unsigned num_threads,
+                           dacpo_kdtree** out,
+                           dacpo_err* err);
+
 void
 dacpo_kdtree_free(dacpo_kdtree* tree);
 

@@ -248,7 +248,7 @@ dacpo_knn_build(const dacpo_cloud* cloud,
     fn = knn_callback_task;
   }
   else {
-    dacpo_status s = dacpo_kdtree_build(cloud->xyz, n, &tree, err);
+    dacpo_status s = dacpo_kdtree_build_threads(cloud->xyz, n, num_threads, &tree, err);
     if (s != DACPO_OK) {
       dacpo_knn_graph_free(out);
       return s;
