@@ -661,7 +661,7 @@ dacpo_scene_mesh(const dacpo_scene_mesh_input* in, dacpo_mesh* out, dacpo_err* e
   memset(out, 0, sizeof(*out));
   const size_t nb = in->blocks->num_blocks;
   dacpo_kdtree* tree = NULL;
-  DACPO_TRY(dacpo_kdtree_build(in->xyz, in->n, &tree, err));
+  DACPO_TRY(dacpo_kdtree_build_threads(in->xyz, in->n, in->num_threads, &tree, err));
   lattice L;
   double spacing = 0.0;
   block_nodes* bn = dacpo_calloc_array(nb ? nb : 1, sizeof(block_nodes));
