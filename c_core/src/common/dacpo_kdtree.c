@@ -65,9 +65,10 @@ struct dacpo_kdtree {
 enum { KD_TASK_DEPTH = 5 };
 
 /* A subtree left for a task: its node, points, depth and the first index of
- * its descendants. */
+ * its descendants; reached: the deepest level the task built. */
 typedef struct kd_task {
   size_t node, begin, end, depth, next;
+  size_t reached;
 } kd_task;
 
 typedef struct kd_build {
@@ -127,7 +128,7 @@ kd_build_node(
   if (end - begin <= KD_LEAF)
     return;
   if (b->tasks && depth == KD_TASK_DEPTH) {
-    b->tasks[b->num_tasks++] = (kd_task){node, begin, end, depth, next};
+    b->tasks[b->num_tasks++] = (kd_task){node, begin, end, depth, next, depth};
     return;
   }
 
@@ -174,8 +175,7 @@ kd_task_run(void* user, size_t task, unsigned thread_id, dacpo_err* err)
   kd_build b = {top->pts, top->nodes, {{0}}, 0, NULL, 0};
   dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 1 + t->node);
   kd_build_node(&b, t->node, t->begin, t->end, t->depth, t->next);
-  /* the depth reached, kept in the task for the caller */
-  top->tasks[task].depth = b.max_depth;
+  top->tasks[task].reached = b.max_depth;
   return DACPO_OK;
 }
 
@@ -193,8 +193,8 @@ kd_build_all(dacpo_kdtree* t, unsigned num_threads, size_t* max_depth, dacpo_err
       b.num_tasks, num_threads, kd_task_run, &b, NULL, DACPO_STAGE_NEIGHBORS, err));
   *max_depth = b.max_depth;
   for (size_t i = 0; i < b.num_tasks; ++i)
-    if (tasks[i].depth > *max_depth)
-      *max_depth = tasks[i].depth;
+    if (tasks[i].reached > *max_depth)
+      *max_depth = tasks[i].reached;
   return DACPO_OK;
 }
 
