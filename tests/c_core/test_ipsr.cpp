@@ -187,6 +187,36 @@ TEST(DacpoIpsr, WavySheetWithFlippedNormalsConverges)
   EXPECT_LE(r.stats.resolution, 128u);
 }
 
+// From settle_start on, an iteration that turns no sample over ends the block.
+// A wavy sheet with true normals: no iteration turns a sample, yet the normals
+// still move by more than the convergence bound (the rim follows the new
+// surface), so the sign test alone ends the run: after iteration settle_start
+// (here 0 or 1; without the test the run goes on to a third iteration).
+TEST(DacpoIpsr, IterationThatTurnsNoSampleOverIsTheLast)
+{
+  for (size_t start : {0u, 1u}) {
+    Cloud c = wavy_sheet(2500, 31);
+    c.flip(0.0, 32);
+    dacpo_ipsr_params prm;
+    dacpo_ipsr_params_default(&prm);
+    prm.settle_start = start;
+    IpsrRun r;
+    run(&c, prm, &r);
+    EXPECT_EQ(r.stats.iterations, start + 1) << "settle_start " << start;
+    EXPECT_TRUE(r.stats.converged);
+    EXPECT_GE(r.stats.final_change, prm.convergence);
+    EXPECT_EQ(c.wrong_percent(), 0.0);
+  }
+  Cloud u = wavy_sheet(2500, 31);
+  u.flip(0.0, 32);
+  dacpo_ipsr_params prm;
+  dacpo_ipsr_params_default(&prm);
+  prm.settle_start = prm.max_iterations; // the sign test off
+  IpsrRun ru;
+  run(&u, prm, &ru);
+  EXPECT_GT(ru.stats.iterations, 2u);
+}
+
 TEST(DacpoIpsr, HalfCylinderWithFlippedNormalsConverges)
 {
   Cloud c = half_cylinder(2500, 21);

@@ -13,7 +13,14 @@
  * unnormalised cross product) to its face_k nearest samples, and take each
  * sample's normalised sum as its new normal (samples that receive nothing
  * keep theirs). Stop when the mean of the largest max(ceil(n/1000), 10)
- * changes |n_new - n_old| is below `convergence`, or after max_iterations.
+ * changes |n_new - n_old| is below `convergence` (Hou et al.'s test), when an
+ * iteration from settle_start on turned no sample over (the sign of its
+ * normal against its input normal), or after max_iterations. The sign is all
+ * the pipeline keeps of a point's stage-3 normal; once the signs hold, further
+ * iterations only turn rim normals by small angles (Hou et al.'s test waits
+ * for the ten largest changes to fall under 0.1, often for the whole run).
+ * The first settle_start iterations run in any case: the normals they refine
+ * shape the mesh stage 4 weighs the blocks' contacts by.
  *
  * Wings: the Neumann surface runs on from the data's rim to the border of the
  * Poisson domain ("extended faces", paper Fig. 4): the box for band 0, a few
@@ -68,6 +75,7 @@ dacpo_ipsr_params_default(dacpo_ipsr_params* p)
   p->convergence = 0.1;
   p->face_k = 10;
   p->trim_start = 5;
+  p->settle_start = 2;
   p->trim_spacings = 2.5;
   p->point_weight = 16.0;
   p->cell_per_spacing = 1.0;
@@ -522,11 +530,12 @@ ipsr_setup(ipsr_work* w,
 /* Every kept face sends its area-weighted normal to its k nearest samples;
  * each sample's new normal is the normalized sum (one that received nothing,
  * or is fixed, keeps its normal). change[s] = |n_new - n_old|. */
-static void
+static size_t
 ipsr_vote(ipsr_work* w,
           const dacpo_mesh* mesh,
           size_t k,
           const uint8_t* fixed,
+          const double* start,
           double* nrm,
           double* old,
           size_t n)
@@ -547,6 +556,7 @@ ipsr_vote(ipsr_work* w,
     }
   }
   memcpy(old, nrm, 3 * n * sizeof(double));
+  size_t turned = 0;
   for (size_t s = 0; s < n; ++s) {
     double* a = w->acc + 3 * s;
     double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
@@ -558,7 +568,13 @@ ipsr_vote(ipsr_work* w,
     double dx = nrm[3 * s] - old[3 * s], dy = nrm[3 * s + 1] - old[3 * s + 1],
            dz = nrm[3 * s + 2] - old[3 * s + 2];
     w->change[s] = sqrt(dx * dx + dy * dy + dz * dz);
+    const double* n0 = start + 3 * s;
+    turned += (n0[0] * nrm[3 * s] + n0[1] * nrm[3 * s + 1] + n0[2] * nrm[3 * s + 2] <
+               0.0) != (n0[0] * old[3 * s] + n0[1] * old[3 * s + 1] +
+                            n0[2] * old[3 * s + 2] <
+                        0.0);
   }
+  return turned;
 }
 
 /* Sizes of one block's iterations, and their last surface. */
@@ -568,6 +584,7 @@ typedef struct ipsr_run {
   size_t top_m; /* changes averaged by the convergence test */
   double far2;  /* squared trimming distance */
   int want_mesh;
+  const double* start;    /* the input normals: the signs are taken against them */
   const dacpo_mesh* mesh; /* the last surface (points into the extractor) */
   int mesh_trimmed;       /* its wings were trimmed */
   int same;               /* the last solve left chi as it was: same surface */
@@ -661,19 +678,20 @@ ipsr_iterate(ipsr_work* w,
     run->mesh_trimmed = trimming;
     if (iters == 0)
       break;
+    size_t turned = 0;
     if (run->same) {
       memset(w->change, 0, n * sizeof(double)); /* the vote would repeat nrm */
       st->surfaces_reused++;
     }
     else {
-      ipsr_vote(w, run->mesh, k, params->fixed, nrm, old, n);
+      turned = ipsr_vote(w, run->mesh, k, params->fixed, run->start, nrm, old, n);
       st->faces_total += run->mesh->num_triangles;
     }
     t[3] = dacpo_now();
     ipsr_iteration_stats(w, run->mesh, k, it, t, st);
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);
     st->final_change = metric;
-    if (metric < params->convergence) {
+    if (metric < params->convergence || (it >= params->settle_start && turned == 0)) {
       st->converged = 1;
       break;
     }
@@ -750,6 +768,7 @@ dacpo_ipsr_block(const double* xyz,
     goto done;
   }
   memcpy(orig, nrm, 3 * n * sizeof(double));
+  run.start = orig;
   saved = 1;
   w.bytes = n * (11 * sizeof(double)) + run.top_m * sizeof(double);
   if ((status = dacpo_kdtree_build(xyz, n, &w.tree, err)) != DACPO_OK)
