@@ -527,9 +527,18 @@ ipsr_setup(ipsr_work* w,
   return DACPO_OK;
 }
 
+/* Whether normal m points away from the input normal n0 (the sign the
+ * pipeline takes from stage 3). */
+static int
+faces_away(const double* n0, const double* m)
+{
+  return n0[0] * m[0] + n0[1] * m[1] + n0[2] * m[2] < 0.0;
+}
+
 /* Every kept face sends its area-weighted normal to its k nearest samples;
  * each sample's new normal is the normalized sum (one that received nothing,
- * or is fixed, keeps its normal). change[s] = |n_new - n_old|. */
+ * or is fixed, keeps its normal). change[s] = |n_new - n_old|. Returns how
+ * many samples turned over (against their input normals `start`). */
 static size_t
 ipsr_vote(ipsr_work* w,
           const dacpo_mesh* mesh,
@@ -568,11 +577,8 @@ ipsr_vote(ipsr_work* w,
     double dx = nrm[3 * s] - old[3 * s], dy = nrm[3 * s + 1] - old[3 * s + 1],
            dz = nrm[3 * s + 2] - old[3 * s + 2];
     w->change[s] = sqrt(dx * dx + dy * dy + dz * dz);
-    const double* n0 = start + 3 * s;
-    turned += (n0[0] * nrm[3 * s] + n0[1] * nrm[3 * s + 1] + n0[2] * nrm[3 * s + 2] <
-               0.0) != (n0[0] * old[3 * s] + n0[1] * old[3 * s + 1] +
-                            n0[2] * old[3 * s + 2] <
-                        0.0);
+    turned += faces_away(start + 3 * s, nrm + 3 * s) !=
+              faces_away(start + 3 * s, old + 3 * s);
   }
   return turned;
 }
