@@ -64,10 +64,11 @@ struct dacpo_kdtree {
  * tree is the same on 1 or 16 threads. */
 enum { KD_TASK_DEPTH = 5 };
 
-/* A subtree left for a task: its node, points, depth and the first index of
- * its descendants; reached: the deepest level the task built. */
+/* A subtree left for a task (its root at depth KD_TASK_DEPTH): its node,
+ * points and the first index of its descendants; reached: the deepest level
+ * the task built. */
 typedef struct kd_task {
-  size_t node, begin, end, depth, next;
+  size_t node, begin, end, next;
   size_t reached;
 } kd_task;
 
@@ -128,7 +129,7 @@ kd_build_node(
   if (end - begin <= KD_LEAF)
     return;
   if (b->tasks && depth == KD_TASK_DEPTH) {
-    b->tasks[b->num_tasks++] = (kd_task){node, begin, end, depth, next, depth};
+    b->tasks[b->num_tasks++] = (kd_task){node, begin, end, next, depth};
     return;
   }
 
@@ -174,7 +175,7 @@ kd_task_run(void* user, size_t task, unsigned thread_id, dacpo_err* err)
   const kd_task* t = &top->tasks[task];
   kd_build b = {top->pts, top->nodes, {{0}}, 0, NULL, 0};
   dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 1 + t->node);
-  kd_build_node(&b, t->node, t->begin, t->end, t->depth, t->next);
+  kd_build_node(&b, t->node, t->begin, t->end, KD_TASK_DEPTH, t->next);
   top->tasks[task].reached = b.max_depth;
   return DACPO_OK;
 }
@@ -188,7 +189,6 @@ kd_build_all(dacpo_kdtree* t, unsigned num_threads, size_t* max_depth, dacpo_err
   kd_build b = {t->pts, t->nodes, {{0}}, 0, tasks, 0};
   dacpo_rng_seed(&b.rng, 0x9E3779B97F4A7C15ULL, 0);
   kd_build_node(&b, 0, 0, t->n, 0, 1);
-  t->num_nodes = 1 + kd_subtree_nodes(t->n);
   DACPO_TRY(dacpo_parallel_for(
       b.num_tasks, num_threads, kd_task_run, &b, NULL, DACPO_STAGE_NEIGHBORS, err));
   *max_depth = b.max_depth;
@@ -231,12 +231,10 @@ dacpo_kdtree_build_threads(const double* xyz,
   if (!t)
     return DACPO_OOM(err);
   t->n = n;
-  /* Every leaf of a tree over n > KD_LEAF points holds >= KD_LEAF / 2 points
-   * (a node with m > KD_LEAF splits into floor(m/2) and ceil(m/2)), so there
-   * are at most 2n/KD_LEAF leaves and twice that many nodes. */
-  size_t cap = 2 * (n / (KD_LEAF / 2)) + 3;
+  /* splits by count: the node count follows from n alone */
+  t->num_nodes = 1 + kd_subtree_nodes(n);
   t->pts = dacpo_malloc_array(n, sizeof(dacpo_tree_point));
-  t->nodes = dacpo_malloc_array(cap, sizeof(kd_node));
+  t->nodes = dacpo_malloc_array(t->num_nodes, sizeof(kd_node));
   if (!t->pts || !t->nodes) {
     dacpo_kdtree_free(t);
     return DACPO_OOM(err);
@@ -245,10 +243,7 @@ dacpo_kdtree_build_threads(const double* xyz,
 
   if (n > 0) {
     size_t depth = 0;
-    dacpo_status st =
-        1 + kd_subtree_nodes(n) <= cap
-            ? kd_build_all(t, num_threads, &depth, err)
-            : dacpo_err_set(err, DACPO_ERR_INTERNAL, "kdtree: node bound");
+    dacpo_status st = kd_build_all(t, num_threads, &depth, err);
     if (st == DACPO_OK && depth >= KD_MAX_DEPTH)
       st = dacpo_err_set(err,
                          DACPO_ERR_INTERNAL,
