@@ -217,6 +217,32 @@ TEST(DacpoIpsr, IterationThatTurnsNoSampleOverIsTheLast)
   EXPECT_GT(ru.stats.iterations, 2u);
 }
 
+// "Few": an iteration from settle_start on that turns over no more samples
+// than the convergence test averages (max(10, n / 1000)) ends the block. A
+// sheet with 4 of 2500 normals flipped is put right by one iteration and stops
+// there (settle_start = 0); with 120 flipped the first iteration turns too
+// many and the run goes on.
+TEST(DacpoIpsr, IterationThatTurnsFewSamplesOverIsTheLast)
+{
+  for (double share : {0.0016, 0.048}) {
+    Cloud c = wavy_sheet(2500, 41);
+    c.flip(share, 42);
+    const double before = c.wrong_percent();
+    ASSERT_GT(before, 0.0);
+    dacpo_ipsr_params prm;
+    dacpo_ipsr_params_default(&prm);
+    prm.settle_start = 0;
+    IpsrRun r;
+    run(&c, prm, &r);
+    EXPECT_EQ(c.wrong_percent(), 0.0) << "share " << share;
+    EXPECT_TRUE(r.stats.converged);
+    if (before * 25.0 <= 10.0) // at most 10 of 2500 flipped
+      EXPECT_EQ(r.stats.iterations, 1u) << "share " << share;
+    else
+      EXPECT_GT(r.stats.iterations, 1u) << "share " << share;
+  }
+}
+
 TEST(DacpoIpsr, HalfCylinderWithFlippedNormalsConverges)
 {
   Cloud c = half_cylinder(2500, 21);

@@ -3,6 +3,7 @@
 // analytic areas, crack-free meshes, interpolated depth, nearest-wins.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -317,4 +318,56 @@ TEST(DacpoRaster, ClippedTriangleAndClear)
   size_t n = dacpo_raster_triangle(&R.r, d, e, f, 1);
   EXPECT_EQ(R.filled(), n);
   EXPECT_NEAR((double)n, 50.0, 0.5 * (20 + std::sqrt(200.0)) + 1);
+}
+
+// One rasterization serves a view and its opposite: the far image handed over
+// by dacpo_raster_take_far equals the near image of the same triangles drawn
+// with z negated (random overlapping triangles, exact depth ties included, in
+// the same order: ties keep the triangle drawn first in both). Pixels the
+// caller added around the drawn rectangle are emptied, and the far image is
+// empty again afterwards.
+TEST(DacpoRaster, FarImageIsTheOppositeView)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(2.0, 46.0), Z(-3.0, 3.0);
+  std::vector<std::array<double, 9>> tris;
+  for (int t = 0; t < 60; ++t) {
+    std::array<double, 9> v{};
+    const double z = t % 7 == 0 ? 1.0 : Z(rng); // every 7th: one depth, ties
+    for (int k = 0; k < 3; ++k) {
+      v[3 * k] = U(rng);
+      v[3 * k + 1] = U(rng);
+      v[3 * k + 2] = t % 7 == 0 ? z : Z(rng);
+    }
+    tris.push_back(v);
+  }
+  Raster both(48, 48), negated(48, 48);
+  dacpo_err err{};
+  ASSERT_EQ(dacpo_raster_keep_far(&both.r, &err), DACPO_OK) << err.msg;
+  for (size_t t = 0; t < tris.size(); ++t) {
+    const double* v = tris[t].data();
+    dacpo_raster_triangle(&both.r, v, v + 3, v + 6, (int32_t)t);
+    double m[9];
+    for (int i = 0; i < 9; ++i)
+      m[i] = i % 3 == 2 ? -v[i] : v[i];
+    dacpo_raster_triangle(&negated.r, m, m + 3, m + 6, (int32_t)t);
+  }
+  const size_t x0 = both.r.x0, y0 = both.r.y0, x1 = both.r.x1, y1 = both.r.y1;
+  ASSERT_LE(x0, x1);
+  // the caller's seam closing may write beyond the drawn rectangle
+  both.r.x0 = 0, both.r.y0 = 0, both.r.x1 = 47, both.r.y1 = 47;
+  both.r.owner[0] = 3, both.r.depth[0] = 0.5f;
+  dacpo_raster_take_far(&both.r, x0, y0, x1, y1);
+  EXPECT_EQ(both.r.x0, x0);
+  EXPECT_EQ(both.r.y1, y1);
+  size_t drawn = 0;
+  for (size_t p = 0; p < 48 * 48; ++p) {
+    EXPECT_EQ(both.r.owner[p], negated.r.owner[p]) << "pixel " << p;
+    if (negated.r.owner[p] >= 0) {
+      ++drawn;
+      EXPECT_EQ(both.r.depth[p], negated.r.depth[p]) << "pixel " << p;
+    }
+    EXPECT_EQ(both.r.far_owner[p], -1);
+  }
+  EXPECT_GT(drawn, 500u);
 }

@@ -14,11 +14,12 @@
  * sample's normalised sum as its new normal (samples that receive nothing
  * keep theirs). Stop when the mean of the largest max(ceil(n/1000), 10)
  * changes |n_new - n_old| is below `convergence` (Hou et al.'s test), when an
- * iteration from settle_start on turned no sample over (the sign of its
- * normal against its input normal), or after max_iterations. The sign is all
- * the pipeline keeps of a point's stage-3 normal; once the signs hold, further
- * iterations only turn rim normals by small angles (Hou et al.'s test waits
- * for the ten largest changes to fall under 0.1, often for the whole run).
+ * iteration from settle_start on turned over (the sign of a normal against
+ * its input normal) no more samples than that test averages, or after
+ * max_iterations. The sign is all the pipeline keeps of a point's stage-3
+ * normal; once the signs hold, further iterations turn rim normals by small
+ * angles (Hou et al.'s test waits for the ten largest changes to fall under
+ * 0.1, often for the whole run) and over a handful of noisy rim samples each.
  * The first settle_start iterations run in any case: the normals they refine
  * shape the mesh stage 4 weighs the blocks' contacts by.
  *
@@ -697,7 +698,8 @@ ipsr_iterate(ipsr_work* w,
     ipsr_iteration_stats(w, run->mesh, k, it, t, st);
     double metric = mean_of_largest(w->change, n, run->top_m, w->heap);
     st->final_change = metric;
-    if (metric < params->convergence || (it >= params->settle_start && turned == 0)) {
+    if (metric < params->convergence ||
+        (it >= params->settle_start && turned <= run->top_m)) {
       st->converged = 1;
       break;
     }

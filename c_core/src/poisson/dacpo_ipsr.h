@@ -19,8 +19,9 @@ typedef struct dacpo_ipsr_params {
   double convergence;    /* 0.1: mean of the largest max(ceil(n/1000),10) |dn| */
   size_t face_k;         /* 10 nearest samples per face */
   size_t trim_start;     /* iteration from which wings are trimmed (5, 0-based) */
-  size_t settle_start;   /* iteration from which one that turns no sample over
-                            is the last (2, 0-based) */
+  size_t settle_start;   /* iteration from which one that turns over at most
+                            max(ceil(n/1000),10) samples is the last (2,
+                            0-based) */
   double trim_spacings;  /* faces farther than this many spacings from the data (2.5) */
   double point_weight;   /* screening alpha, PSR convention (16) */
   double cell_per_spacing; /* cell size / median spacing (1.0) */
@@ -61,8 +62,8 @@ typedef struct dacpo_ipsr_stats {
   size_t surfaces_reused; /* iterations whose solve left the surface as it was */
   double final_change;    /* last convergence measure */
   int converged;          /* 1 if it stopped on the convergence test or on an
-                             iteration (from settle_start on) that turned no
-                             sample over */
+                             iteration (from settle_start on) that turned
+                             over few samples */
   size_t domain_cells;    /* cells the Poisson solve works on (<= dims product) */
 } dacpo_ipsr_stats;
 

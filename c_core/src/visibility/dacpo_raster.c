@@ -66,7 +66,62 @@ dacpo_raster_free(dacpo_raster* r)
     return;
   free(r->depth);
   free(r->owner);
+  free(r->far_depth);
+  free(r->far_owner);
   memset(r, 0, sizeof(*r));
+}
+
+dacpo_status
+dacpo_raster_keep_far(dacpo_raster* r, dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              r != NULL && r->depth != NULL && r->x0 > r->x1,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "dacpo_raster_keep_far: no empty image");
+  if (r->far_depth != NULL)
+    return DACPO_OK;
+  size_t n = r->width * r->height;
+  r->far_depth = (float*)dacpo_malloc_array(n, sizeof(float));
+  r->far_owner = (int32_t*)dacpo_malloc_array(n, sizeof(int32_t));
+  if (r->far_depth == NULL || r->far_owner == NULL) {
+    free(r->far_depth);
+    free(r->far_owner);
+    r->far_depth = NULL;
+    r->far_owner = NULL;
+    return DACPO_OOM(err);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    r->far_depth[i] = -INFINITY;
+    r->far_owner[i] = -1;
+  }
+  return DACPO_OK;
+}
+
+void
+dacpo_raster_take_far(dacpo_raster* r, size_t x0, size_t y0, size_t x1, size_t y1)
+{
+  if (r == NULL || r->far_depth == NULL)
+    return;
+  /* empty what was added around the drawn rectangle */
+  const size_t dx0 = r->x0, dx1 = r->x1, dy0 = r->y0, dy1 = r->y1;
+  for (size_t y = dy0; dx0 <= dx1 && y <= dy1; ++y)
+    for (size_t x = dx0; x <= dx1; ++x) {
+      r->depth[y * r->width + x] = INFINITY;
+      r->owner[y * r->width + x] = -1;
+    }
+  for (size_t y = y0; x0 <= x1 && y <= y1; ++y)
+    for (size_t x = x0; x <= x1; ++x) {
+      const size_t p = y * r->width + x;
+      const int32_t id = r->far_owner[p];
+      r->depth[p] = id >= 0 ? -r->far_depth[p] : INFINITY;
+      r->owner[p] = id;
+      r->far_depth[p] = -INFINITY;
+      r->far_owner[p] = -1;
+    }
+  r->x0 = x0;
+  r->x1 = x1;
+  r->y0 = y0;
+  r->y1 = y1;
 }
 
 void
@@ -80,6 +135,11 @@ dacpo_raster_clear(dacpo_raster* r)
       r->depth[row + x] = INFINITY;
       r->owner[row + x] = -1;
     }
+    if (r->far_depth != NULL)
+      for (size_t x = r->x0; x <= r->x1; ++x) {
+        r->far_depth[row + x] = -INFINITY;
+        r->far_owner[row + x] = -1;
+      }
   }
   r->x0 = 1;
   r->x1 = 0;
@@ -236,6 +296,8 @@ raster_scan(dacpo_raster* r, const int64_t range[4], raster_steps* s, int32_t id
     double z = s->z_row;
     float* drow = r->depth + (size_t)py * r->width;
     int32_t* orow = r->owner + (size_t)py * r->width;
+    float* frow = r->far_depth ? r->far_depth + (size_t)py * r->width : NULL;
+    int32_t* forow = r->far_owner ? r->far_owner + (size_t)py * r->width : NULL;
     for (int64_t px = range[0]; px <= range[1]; ++px) {
       if ((e0 | e1 | e2) >= 0) {
         ++covered;
@@ -243,6 +305,10 @@ raster_scan(dacpo_raster* r, const int64_t range[4], raster_steps* s, int32_t id
         if (zf < drow[px]) {
           drow[px] = zf;
           orow[px] = id;
+        }
+        if (frow && zf > frow[px]) {
+          frow[px] = zf;
+          forow[px] = id;
         }
       }
       e0 += s->step_x[0];

@@ -14,7 +14,10 @@
  *  1. project every used vertex (orthographic, or a pinhole camera at distance
  *     2R from the centre) and fit the projection into image_size^2 square pixels;
  *  2. rasterize all triangles of both meshes once into one z-buffer (exact
- *     coverage, interpolated depth; dacpo_raster.c);
+ *     coverage, interpolated depth; dacpo_raster.c). Orthographic views come
+ *     in opposite pairs (d, -d) that cover the same pixels: one pass keeps
+ *     the nearest and the farthest triangle of every pixel, and view -d is
+ *     the far image, mirrored (no pass below can tell a mirror image);
  *  3. eta = largest depth span max D(v) - min D(v) of a triangle that owns at
  *     least one pixel (params->experiment.eta_all: of every triangle, the paper's
  * formula); optional removal of partly visible triangles; seam closing: empty pixels
@@ -34,13 +37,11 @@
  * Counts are scaled (C1, C2 by 1/image_size^2, C_B by 1/image_size) so alpha does
  * not depend on the image size; omega (Eq. 7) is scale-free anyway.
  *
- * Cost: O(V + T + image area) per view. Measured (thread CPU time, shared
- * 2-core machine): two 5K-triangle sheets 18 ms per edge at 400 px (8 ms at
- * 200 px; bench_vcr.c); stage-3 meshes of real scans (~7K triangles per block)
- * ~30 ms per edge at 400 px, 22 ms at 300 px, 15 ms at 200 px. About half is
- * rasterization (per-triangle setup: the triangles are a few pixels wide), half
- * the per-pixel passes. Scratch (~50 bytes per pixel) is allocated per call; no
- * global state, so edges can run on several threads at once.
+ * Cost: O(V + T) per rasterization (one per pair of opposite views) and
+ * O(image area) per view; the rasterization's per-triangle setup dominates
+ * (stage-3 triangles are a few pixels wide). Scratch (~58 bytes per pixel) is
+ * allocated per call; no global state, so edges can run on several threads at
+ * once.
  * Failures: bad parameters, out-of-range indices or non-finite vertices
  * (DACPO_ERR_INVALID_ARGUMENT), allocation (DACPO_ERR_OUT_OF_MEMORY). Empty
  * meshes or degenerate geometry give alpha = alpha_bar = 0 and DACPO_OK. */
@@ -134,6 +135,7 @@ typedef struct vcr_work {
   uint8_t* cls;       /* N^2: 0 empty, else 1 + 2 * mesh + back */
   int32_t* atom;      /* N^2: compact atom id */
   uint8_t* flags;     /* N^2 */
+  size_t drawn[4];    /* x0, y0, x1, y1 of the pixels drawn in this view */
   /* per atom (at most N^2) */
   uint8_t* a_blk;
   int32_t* a_cnt;
@@ -392,12 +394,33 @@ view_project(vcr_work* w,
   return 1;
 }
 
+/* cls (1 = drawn, 0 = empty: for the seam closing, pass 4 overwrites it) and
+ * the pixels each triangle won; perspective depths back from -1/depth. */
+static void
+view_owned(vcr_work* w, int persp)
+{
+  const size_t N = w->N;
+  dacpo_raster* R = &w->r;
+  memset(w->owned, 0, w->nt * sizeof(int32_t));
+  uint8_t* cls = w->cls;
+  for (size_t y = R->y0; y <= R->y1; ++y)
+    for (size_t x = R->x0; x <= R->x1; ++x) {
+      size_t p = y * N + x;
+      int32_t t = R->owner[p];
+      cls[p] = t >= 0 ? 1 : 0;
+      if (t >= 0) {
+        w->owned[t]++;
+        if (persp)
+          R->depth[p] = (float)(-1.0 / (double)R->depth[p]);
+      }
+    }
+}
+
 /* Step 2: facing of every triangle and z-buffer rasterization (a first, then
  * b: exact depth ties keep a). Returns 0 when nothing was drawn. */
 static int
 view_rasterize(vcr_work* w, const view_camera* cam)
 {
-  const size_t N = w->N;
   const int persp = cam->persp;
   const double *d = cam->d, *eye = cam->eye;
   /* 2. facing and rasterization (a first, then b: exact depth ties keep a) */
@@ -414,25 +437,12 @@ view_rasterize(vcr_work* w, const view_camera* cam)
     size_t i0 = corner(w, t, 0), i1 = corner(w, t, 1), i2 = corner(w, t, 2);
     w->covered[t] = (int32_t)dacpo_raster_triangle(
         &w->r, &w->scr[3 * i0], &w->scr[3 * i1], &w->scr[3 * i2], (int32_t)t);
-    w->owned[t] = 0;
   }
   dacpo_raster* R = &w->r;
   if (R->x0 > R->x1)
     return 0;
-  /* cls: 1 = drawn, 0 = empty (for the seam closing; pass 4 overwrites it) */
-  uint8_t* cls = w->cls;
-  for (size_t y = R->y0; y <= R->y1; ++y)
-    for (size_t x = R->x0; x <= R->x1; ++x) {
-      size_t p = y * N + x;
-      int32_t t = R->owner[p];
-      cls[p] = t >= 0 ? 1 : 0;
-      if (t >= 0) {
-        w->owned[t]++;
-        if (persp)
-          R->depth[p] = (float)(-1.0 / (double)R->depth[p]);
-      }
-    }
-
+  w->drawn[0] = R->x0, w->drawn[1] = R->y0, w->drawn[2] = R->x1, w->drawn[3] = R->y1;
+  view_owned(w, persp);
   return 1;
 }
 
@@ -758,9 +768,27 @@ view_regions(vcr_work* w, const dacpo_vcr_params* prm, int32_t K, view_result* r
   }
 }
 
-/* One view: steps 1-5 of the file comment. Returns 0 contributions when the
- * projection is degenerate. images: NULL or N*N bytes. */
+/* Steps 3-5 of one view on the drawn image. */
 static void
+view_passes(vcr_work* w,
+            const dacpo_vcr_params* prm,
+            double radius,
+            view_result* res,
+            uint8_t* image)
+{
+  const double eta = view_eta(w, prm);
+  view_close_seams(w, res->gap);
+  /* float depths: allow a few ulps of the scene size on top of eta */
+  view_atoms(w, eta + 1e-5 * radius, res);
+  const int32_t K = view_compact_atoms(w, image);
+  view_regions(w, prm, K, res);
+  res->eta = eta;
+}
+
+/* One view: steps 1-5 of the file comment. Returns 0 (and 0 contributions)
+ * when the projection is degenerate or nothing is drawn. images: NULL or N*N
+ * bytes. */
+static int
 run_view(vcr_work* w,
          const dacpo_vcr_params* prm,
          const double centre[3],
@@ -779,17 +807,67 @@ run_view(vcr_work* w,
     cam.eye[k] = cam.persp ? centre[k] - cam.dist * d[k] : 0.0;
   size_t gap = 0;
   if (!view_project(w, prm, centre, radius, &cam, &gap))
-    return;
+    return 0;
   res->gap = gap;
   if (!view_rasterize(w, &cam))
-    return;
-  const double eta = view_eta(w, prm);
-  view_close_seams(w, gap);
-  /* float depths: allow a few ulps of the scene size on top of eta */
-  view_atoms(w, eta + 1e-5 * radius, res);
-  const int32_t K = view_compact_atoms(w, image);
-  view_regions(w, prm, K, res);
-  res->eta = eta;
+    return 0;
+  view_passes(w, prm, radius, res, image);
+  return 1;
+}
+
+/* The view opposite to the last one run_view drew (orthographic, with the far
+ * image kept): the same pixels, the farthest triangle of each, facings turned.
+ * The image is the mirror of what a camera looking along -d would see, which
+ * no pass can tell: they count pixels and their 4-neighbours only. */
+static void
+run_opposite_view(vcr_work* w,
+                  const dacpo_vcr_params* prm,
+                  double radius,
+                  const double d[3],
+                  const view_result* near,
+                  view_result* res,
+                  uint8_t* image)
+{
+  memset(res, 0, sizeof(*res));
+  res->gap = near->gap;
+  dacpo_raster_take_far(&w->r, w->drawn[0], w->drawn[1], w->drawn[2], w->drawn[3]);
+  for (size_t t = 0; t < w->nt; ++t) {
+    const double* n = &w->tri_normal[3 * t];
+    w->back[t] = d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0 ? 1 : 0;
+  }
+  for (size_t i = 0; i < w->nv; ++i)
+    w->vdepth[i] = -w->vdepth[i];
+  view_owned(w, 0);
+  view_passes(w, prm, radius, res, image);
+}
+
+/* For orthographic views: opposite[j] = the view exactly opposite to j (j if
+ * none). NULL if no view has an opposite, for perspective views (their
+ * cameras see different sides of the pair), or without memory (every view is
+ * then drawn on its own). */
+static size_t*
+opposite_views(const double* dirs, size_t num_views, int perspective)
+{
+  if (perspective)
+    return NULL;
+  size_t* opposite = (size_t*)dacpo_malloc_array(num_views, sizeof(size_t));
+  if (opposite == NULL)
+    return NULL;
+  int any = 0;
+  for (size_t j = 0; j < num_views; ++j) {
+    opposite[j] = j;
+    for (size_t i = 0; i < num_views && opposite[j] == j; ++i) {
+      const double* a = dirs + 3 * j;
+      const double* b = dirs + 3 * i;
+      if (a[0] == -b[0] && a[1] == -b[1] && a[2] == -b[2] && i != j)
+        opposite[j] = i, any = 1;
+    }
+  }
+  if (!any) {
+    free(opposite);
+    return NULL;
+  }
+  return opposite;
 }
 
 /* The parameters dacpo_vcr_edge accepts. */
@@ -891,6 +969,55 @@ view_stats(const view_result* res, const double dir[3], dacpo_vcr_view_stats* vs
   vs->gap_pixels = res->gap;
 }
 
+/* Every view's contributions summed into sum_a, sum_b (and its statistics
+ * and image in views, images when given); views j and opposite[j] > j share
+ * one rasterization. Without memory for the far image, every view is drawn
+ * on its own (the same result up to the mirror's pixel grid). */
+static void
+vcr_views(vcr_work* w,
+          const dacpo_vcr_params* prm,
+          const double* dirs,
+          const double centre[3],
+          double radius,
+          dacpo_vcr_view_stats* views,
+          uint8_t* images,
+          double* sum_a,
+          double* sum_b)
+{
+  size_t* opposite = opposite_views(dirs, prm->num_views, prm->perspective);
+  dacpo_err ignored;
+  if (opposite != NULL && dacpo_raster_keep_far(&w->r, &ignored) != DACPO_OK) {
+    free(opposite);
+    opposite = NULL;
+  }
+  const size_t npix = w->N * w->N;
+  for (size_t j = 0; j < prm->num_views; ++j) {
+    if (opposite != NULL && opposite[j] < j)
+      continue; /* drawn with its opposite */
+    view_result res;
+    dacpo_raster_clear(&w->r);
+    const int drawn = run_view(
+        w, prm, centre, radius, &dirs[3 * j], &res, images ? images + j * npix : NULL);
+    *sum_a += res.alpha;
+    *sum_b += res.alpha_bar;
+    if (views != NULL)
+      view_stats(&res, &dirs[3 * j], &views[j]);
+    const size_t o = opposite != NULL ? opposite[j] : j;
+    if (o == j)
+      continue;
+    view_result ores;
+    memset(&ores, 0, sizeof(ores));
+    if (drawn)
+      run_opposite_view(
+          w, prm, radius, &dirs[3 * o], &res, &ores, images ? images + o * npix : NULL);
+    *sum_a += ores.alpha;
+    *sum_b += ores.alpha_bar;
+    if (views != NULL)
+      view_stats(&ores, &dirs[3 * o], &views[o]);
+  }
+  free(opposite);
+}
+
 dacpo_status
 dacpo_vcr_edge(const dacpo_mesh* a,
                const dacpo_mesh* b,
@@ -945,24 +1072,8 @@ dacpo_vcr_edge(const dacpo_mesh* a,
   vcr_prepare(&w, centre, &radius);
 
   double sum_a = 0.0, sum_b = 0.0;
-  if (radius > 0.0 && isfinite(radius)) {
-    size_t npix = w.N * w.N;
-    for (size_t j = 0; j < prm.num_views; ++j) {
-      view_result res;
-      dacpo_raster_clear(&w.r);
-      run_view(&w,
-               &prm,
-               centre,
-               radius,
-               &dirs[3 * j],
-               &res,
-               images ? images + j * npix : NULL);
-      sum_a += res.alpha;
-      sum_b += res.alpha_bar;
-      if (views != NULL)
-        view_stats(&res, &dirs[3 * j], &views[j]);
-    }
-  }
+  if (radius > 0.0 && isfinite(radius))
+    vcr_views(&w, &prm, dirs, centre, radius, views, images, &sum_a, &sum_b);
   free(dirs);
   work_free(&w);
   *alpha = sum_a;
