@@ -21,7 +21,10 @@
  * angles (Hou et al.'s test waits for the ten largest changes to fall under
  * 0.1, often for the whole run) and over a handful of noisy rim samples each.
  * The first settle_start iterations run in any case: the normals they refine
- * shape the mesh stage 4 weighs the blocks' contacts by.
+ * shape the mesh stage 4 weighs the blocks' contacts by. The tolerance is at
+ * least 10 samples, so blocks of fewer than 100 samples (tiny parts only:
+ * a part of n points gets about n/625 blocks, each with a ring) may stop with
+ * more than one in ten turning.
  *
  * Wings: the Neumann surface runs on from the data's rim to the border of the
  * Poisson domain ("extended faces", paper Fig. 4): the box for band 0, a few

@@ -836,19 +836,21 @@ run_opposite_view(vcr_work* w,
     w->back[t] = d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0 ? 1 : 0;
   }
   for (size_t i = 0; i < w->nv; ++i)
-    w->vdepth[i] = -w->vdepth[i];
+    if (w->used[i])
+      w->vdepth[i] = -w->vdepth[i];
   view_owned(w, 0);
   view_passes(w, prm, radius, res, image);
 }
 
 /* For orthographic views: opposite[j] = the view exactly opposite to j (j if
- * none). NULL if no view has an opposite, for perspective views (their
- * cameras see different sides of the pair), or without memory (every view is
- * then drawn on its own). */
+ * none). NULL for perspective views (their cameras see different sides of
+ * the pair), beyond 12 views (the spiral's directions have no exact
+ * opposites: only the icosahedron's come in pairs), when no view has an
+ * opposite, or without memory (every view is then drawn on its own). */
 static size_t*
 opposite_views(const double* dirs, size_t num_views, int perspective)
 {
-  if (perspective)
+  if (perspective || num_views > 12)
     return NULL;
   size_t* opposite = (size_t*)dacpo_malloc_array(num_views, sizeof(size_t));
   if (opposite == NULL)
@@ -1007,6 +1009,7 @@ vcr_views(vcr_work* w,
       continue;
     view_result ores;
     memset(&ores, 0, sizeof(ores));
+    ores.gap = res.gap;
     if (drawn)
       run_opposite_view(
           w, prm, radius, &dirs[3 * o], &res, &ores, images ? images + o * npix : NULL);

@@ -93,7 +93,9 @@ typedef struct dacpo_vcr_view_stats {
 /* What dacpo_vcr_edge can report besides alpha / alpha_bar (trace NULL: nothing):
  * per-view statistics (views: NULL or params->num_views entries) and label
  * images (images: NULL or num_views * image_size * image_size bytes, row-major,
- * codes above; views that draw nothing stay 0). */
+ * codes above; views that draw nothing stay 0). An orthographic view drawn
+ * with its opposite (dacpo_vcr.c) is stored as the opposite view's pixel grid
+ * sees it: mirrored against a camera of its own. */
 struct dacpo_vcr_trace {
   dacpo_vcr_view_stats* views;
   uint8_t* images;
