@@ -102,7 +102,8 @@ dacpo_raster_take_far(dacpo_raster* r, size_t x0, size_t y0, size_t x1, size_t y
 {
   if (r == NULL || r->far_depth == NULL)
     return;
-  /* empty what was added around the drawn rectangle */
+  /* empty the dirty rectangle (the caller may have grown it), then copy the
+   * far image over the drawn one */
   const size_t dx0 = r->x0, dx1 = r->x1, dy0 = r->y0, dy1 = r->y1;
   for (size_t y = dy0; dx0 <= dx1 && y <= dy1; ++y)
     for (size_t x = dx0; x <= dx1; ++x) {

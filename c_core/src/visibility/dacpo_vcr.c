@@ -816,20 +816,24 @@ run_view(vcr_work* w,
 }
 
 /* The view opposite to the last one run_view drew (orthographic, with the far
- * image kept): the same pixels, the farthest triangle of each, facings turned.
- * The image is the mirror of what a camera looking along -d would see, which
- * no pass can tell: they count pixels and their 4-neighbours only. */
+ * image kept; near_drawn: what run_view returned): the same pixels, the
+ * farthest triangle of each, facings turned. The image is the mirror of
+ * what a camera looking along -d would see, which no pass can tell: they
+ * count pixels and their 4-neighbours only. */
 static void
 run_opposite_view(vcr_work* w,
                   const dacpo_vcr_params* prm,
                   double radius,
                   const double d[3],
+                  int near_drawn,
                   const view_result* near,
                   view_result* res,
                   uint8_t* image)
 {
   memset(res, 0, sizeof(*res));
   res->gap = near->gap;
+  if (!near_drawn)
+    return; /* nothing to see from this side either */
   dacpo_raster_take_far(&w->r, w->drawn[0], w->drawn[1], w->drawn[2], w->drawn[3]);
   for (size_t t = 0; t < w->nt; ++t) {
     const double* n = &w->tri_normal[3 * t];
@@ -1008,11 +1012,14 @@ vcr_views(vcr_work* w,
     if (o == j)
       continue;
     view_result ores;
-    memset(&ores, 0, sizeof(ores));
-    ores.gap = res.gap;
-    if (drawn)
-      run_opposite_view(
-          w, prm, radius, &dirs[3 * o], &res, &ores, images ? images + o * npix : NULL);
+    run_opposite_view(w,
+                      prm,
+                      radius,
+                      &dirs[3 * o],
+                      drawn,
+                      &res,
+                      &ores,
+                      images ? images + o * npix : NULL);
     *sum_a += ores.alpha;
     *sum_b += ores.alpha_bar;
     if (views != NULL)

@@ -104,11 +104,9 @@ struct SearchAdapter {
       std::size_t kq = static_cast<std::size_t>(std::min<double>(guess, limit));
       kq = std::max<std::size_t>(std::min(k, limit), kq);
 
-      /* One set of buffers per thread: the core asks once per point, and three
-       * allocations per query cost more than the answer's copying. */
-      static thread_local pcl::Indices nn;
-      static thread_local std::vector<float> nd;
-      static thread_local std::vector<std::pair<float, pcl::index_t>> order;
+      pcl::Indices nn;
+      std::vector<float> nd;
+      std::vector<std::pair<float, pcl::index_t>> order;
       for (;;) {
         const int got = self->search->nearestKSearch(q, static_cast<int>(kq), nn, nd);
         if (got < 0) {
