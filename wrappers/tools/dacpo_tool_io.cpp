@@ -15,6 +15,8 @@
 #include <sstream>
 #include <string>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 namespace dacpo_tool {
 
@@ -174,18 +176,20 @@ plyBytes(const pcl::PCLPointCloud2& cloud)
                                                   Eigen::Quaternionf::Identity(),
                                                   static_cast<int>(cloud.width),
                                                   false);
+  std::vector<std::pair<std::size_t, std::size_t>> spans; /* offset, size */
   std::size_t row = 0;
-  for (const auto& f : cloud.fields)
-    row += pcl::getFieldSize(f.datatype);
+  for (const auto& f : cloud.fields) {
+    spans.emplace_back(f.offset, pcl::getFieldSize(f.datatype));
+    row += spans.back().second;
+  }
   const std::size_t head = bytes.size();
   bytes.resize(head + row * cloud.width);
   char* out = &bytes[head];
   const std::uint8_t* in = cloud.data.data();
   for (std::size_t i = 0; i < cloud.width; ++i, in += cloud.point_step)
-    for (const auto& f : cloud.fields) {
-      const std::size_t size = pcl::getFieldSize(f.datatype);
-      std::memcpy(out, in + f.offset, size);
-      out += size;
+    for (const auto& span : spans) {
+      std::memcpy(out, in + span.first, span.second);
+      out += span.second;
     }
   return bytes;
 }
