@@ -282,7 +282,90 @@ block_sizes(const dacpo_blocks& b)
   return sz;
 }
 
+// A w x h grid folded at a right angle after column fold: columns < fold lie
+// in z = 0 (axis +z), the others stand at x = fold (axis +x). The adjacency
+// is the grid's, whatever the fold.
+Scene
+folded_grid_scene(int w, int h, int fold)
+{
+  Scene s = grid_scene(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = fold; x < w; ++x) {
+      double* p = &s.xyz[3 * (size_t)(y * w + x)];
+      p[0] = fold;
+      p[2] = x - fold + 1;
+    }
+  for (size_t i = 0; i < s.n(); ++i)
+    s.nrm[3 * i + (s.xyz[3 * i] < fold ? 2 : 0)] = 1.0;
+  return s;
+}
+
+// Blocks holding points of both faces of a folded grid.
+size_t
+blocks_across_fold(const Scene& s, const dacpo_blocks& b, int fold)
+{
+  size_t mixed = 0;
+  for (size_t k = 0; k < b.num_blocks; ++k) {
+    bool flat = false, standing = false;
+    for (size_t t = b.own_start[k]; t < b.own_start[k + 1]; ++t)
+      (s.xyz[3 * (size_t)b.own[t]] < fold ? flat : standing) = true;
+    mixed += flat && standing;
+  }
+  return mixed;
+}
+
 } // namespace
+
+TEST(DacpoSegment, CreaseAxesPutTheBlockBorderOnTheFold)
+{
+  // 24 flat and 16 standing columns, 2 blocks: the median split leaves 4 flat
+  // columns with the standing face, whose seed is on the standing face. Hop
+  // distance puts the border midway between the seeds, on the flat face;
+  // a step across the fold costs 21 hops, so the crease growth stops there.
+  Scene s = folded_grid_scene(40, 8, 24);
+  dacpo_err err{};
+  dacpo_blocks plain{}, creased{};
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 2, 1, &plain, &err),
+            DACPO_OK)
+      << err.msg;
+  ASSERT_EQ(dacpo_segment_creased(
+                &s.cloud, &s.adj, s.nrm.data(), s.component.data(), 1, 2, 1, &creased, &err),
+            DACPO_OK)
+      << err.msg;
+  ASSERT_EQ(plain.num_blocks, 2u);
+  ASSERT_EQ(creased.num_blocks, 2u);
+  EXPECT_EQ(blocks_across_fold(s, plain, 24), 1u);
+  EXPECT_EQ(blocks_across_fold(s, creased, 24), 0u);
+  expect_valid(s, creased, 1);
+  dacpo_blocks_free(&plain);
+  dacpo_blocks_free(&creased);
+}
+
+TEST(DacpoSegment, CreaseGrowthOnAFlatSurfaceIsTheBfs)
+{
+  // Equal axes everywhere: every step costs 1, so the shortest paths are the
+  // BFS's hop counts and the blocks are the same (ties go to the lower index
+  // in both: the BFS by queue order, which follows the seed order).
+  Scene s = grid_scene(60, 40);
+  for (size_t i = 0; i < s.n(); ++i)
+    s.nrm[3 * i + 2] = 1.0;
+  dacpo_err err{};
+  dacpo_blocks plain{}, creased{};
+  ASSERT_EQ(dacpo_segment(&s.cloud, &s.adj, s.component.data(), 1, 6, 2, &plain, &err),
+            DACPO_OK);
+  ASSERT_EQ(dacpo_segment_creased(
+                &s.cloud, &s.adj, s.nrm.data(), s.component.data(), 1, 6, 2, &creased, &err),
+            DACPO_OK);
+  ASSERT_EQ(plain.num_blocks, creased.num_blocks);
+  size_t differ = 0;
+  for (size_t i = 0; i < s.n(); ++i)
+    differ += plain.block_of[i] != creased.block_of[i];
+  // only points at equal distance from two seeds may go either way
+  EXPECT_LE(differ, s.n() / 20);
+  expect_valid(s, creased, 2);
+  dacpo_blocks_free(&plain);
+  dacpo_blocks_free(&creased);
+}
 
 TEST(DacpoSegment, GridSplitsIntoSixteenConnectedEqualBlocks)
 {

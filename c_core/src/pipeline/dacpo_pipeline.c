@@ -14,6 +14,7 @@
 #include "dacpo_block_unit.h"
 #include "dacpo_bridge.h"
 #include "dacpo_context.h"
+#include "dacpo_crease_axes.h"
 #include "dacpo_dipole.h"
 #include "dacpo_global_sign.h"
 #include "dacpo_ilp.h"
@@ -451,18 +452,33 @@ auto_blocks(size_t n)
   return b;
 }
 /* Stage 1: blocks, overlap rings and the block graph. */
+/* Stage 1 with crease axes: they need the neighbour rows (the first
+ * normal_k of them, or all there are), which are trimmed right after. */
 static dacpo_status
 segment_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
-  DACPO_TRY(dacpo_segment(&s->cloud,
-                          &s->adj,
-                          s->component,
-                          s->num_components,
-                          target,
-                          s->p.ring_hops,
-                          &s->blocks,
-                          err));
+  double* axes = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
+  if (axes == NULL)
+    return DACPO_OOM(err);
+  const size_t k = s->p.normal_k < s->knn.k ? s->p.normal_k : s->knn.k;
+  dacpo_status status =
+      dacpo_crease_axes(&s->cloud, &s->knn, k, s->p.num_threads, axes, err);
+  /* the neighbour rows are done with (the adjacency holds the graph); the
+   * global sign reads only each row's reach */
+  dacpo_knn_graph_keep_farthest(&s->knn);
+  if (status == DACPO_OK)
+    status = dacpo_segment_creased(&s->cloud,
+                                   &s->adj,
+                                   axes,
+                                   s->component,
+                                   s->num_components,
+                                   target,
+                                   s->p.ring_hops,
+                                   &s->blocks,
+                                   err);
+  free(axes);
+  DACPO_TRY(status);
   DACPO_TRY(dacpo_block_graph_build(&s->blocks, &s->adj, &s->bgraph, err));
   st->num_blocks = s->blocks.num_blocks;
   st->num_block_edges = s->bgraph.num_edges;
@@ -679,9 +695,6 @@ job_prepare(dacpo_job* job,
     DACPO_TRY(estimate_normals(s, err));
   DACPO_TRY(resolve_scan_kind(s, st, err));
   DACPO_TRY(stage_done(job, DACPO_STAGE_NORMALS, err));
-  /* the neighbour rows are done with (the adjacency holds the graph); the
-   * global sign reads only each row's reach */
-  dacpo_knn_graph_keep_farthest(&s->knn);
   DACPO_TRY(segment_blocks(s, st, err));
   DACPO_TRY(alloc_block_results(s, err));
   return stage_done(job, DACPO_STAGE_SEGMENT, err);

@@ -32,6 +32,22 @@ dacpo_segment(const dacpo_cloud* cloud,
               dacpo_blocks* out,
               dacpo_err* err);
 
+/* The same with the block fronts advancing by shortest paths in which a step
+ * from p to q costs 1 + 20 (1 - |a_p . a_q|) hops (a_p: crease_axes[3p..],
+ * unit; see dacpo_crease_axes()), so block borders settle on creases. Each
+ * block is still connected in adj. crease_axes NULL is dacpo_segment().
+ * O(E log n). */
+dacpo_status
+dacpo_segment_creased(const dacpo_cloud* cloud,
+                      const dacpo_adjacency* adj,
+                      const double* crease_axes,
+                      const int32_t* component,
+                      size_t num_components,
+                      size_t target_blocks,
+                      size_t ring_hops,
+                      dacpo_blocks* out,
+                      dacpo_err* err);
+
 /* NULL-safe; frees every array and zeroes the struct. */
 void
 dacpo_blocks_free(dacpo_blocks* b);
