@@ -443,7 +443,11 @@ TEST(DacpoPipeline, SideCueAnchorsABlockTheSeamsVoteWrong)
 // ---- published results --------------------------------------------------------
 
 // Two copies of the box, 100 m apart, in a shuffled input order: every
-// per-point array must follow the input order.
+// per-point array must follow the input order. Each box is oriented on its
+// own (DACPO_DISCONNECTED_SEPARATE): under the viewpoint policy the second
+// open box is a part that wraps around its centroid, which the closed-part
+// rule turns outward (docs/DESIGN.md, "Known limits"), and that rule is not
+// what this test is about.
 TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
 {
   Scene sc(DACPO_SCENE_BOX_OPEN, 8000, 2);
@@ -469,6 +473,7 @@ TEST(DacpoPipeline, PerPointOutputsFollowInputOrder)
   }
   dacpo_params p = defaults();
   p.estimate_normals = 1;
+  p.disconnected = DACPO_DISCONNECTED_SEPARATE;
   auto ctx = makeCtx();
   Result r = orient(ctx.get(), p, xyz.data(), std::vector<float>(3 * n, 0.0f), n);
   ASSERT_EQ(r.status, DACPO_OK) << r.error;
