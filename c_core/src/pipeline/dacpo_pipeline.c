@@ -451,9 +451,9 @@ auto_blocks(size_t n)
     b = 400;
   return b;
 }
-/* Stage 1: blocks, overlap rings and the block graph. */
-/* Stage 1 with crease axes: they need the neighbour rows (the first
- * normal_k of them, or all there are), which are trimmed right after. */
+/* Stage 1: blocks bordered by creases, overlap rings and the block graph.
+ * The crease axes need the neighbour rows (the first normal_k of them, or all
+ * there are), which are trimmed right after. */
 static dacpo_status
 segment_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
