@@ -496,7 +496,9 @@ seg_place_seeds(seg_splitter* sp,
 }
 
 /* A step across a crease costs 1 + SEG_CREASE_COST (1 - |a_p . a_q|) hops:
- * 21 at a right angle, 1.3 at the 7 degrees of noise the crease axes keep.
+ * 21 at a right angle, 1.15 at 7 degrees and 1.03 at 3 degrees of axis
+ * noise (a copy-laden scan's raw PCA axes, and the crease axes after
+ * averaging).
  * Orienting a block across a crease is where stage 2 fails (the dipole field
  * of one face is nearly tangent to the other); between blocks, stage 4's
  * visibility decides it. */
