@@ -458,12 +458,17 @@ static dacpo_status
 segment_blocks(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   size_t target = s->p.num_blocks ? s->p.num_blocks : auto_blocks(s->cloud.n);
-  double* axes = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
-  if (axes == NULL)
-    return DACPO_OOM(err);
-  const size_t k = s->p.normal_k < s->knn.k ? s->p.normal_k : s->knn.k;
-  dacpo_status status =
-      dacpo_crease_axes(&s->cloud, &s->knn, k, s->p.num_threads, axes, err);
+  /* one block per component (target 1) leaves the growth nothing to decide:
+   * no crease axes then */
+  double* axes = NULL;
+  dacpo_status status = DACPO_OK;
+  if (target > 1) {
+    axes = dacpo_malloc_array(3 * s->cloud.n, sizeof(double));
+    if (axes == NULL)
+      return DACPO_OOM(err);
+    const size_t k = s->p.normal_k < s->knn.k ? s->p.normal_k : s->knn.k;
+    status = dacpo_crease_axes(&s->cloud, &s->knn, k, s->p.num_threads, axes, err);
+  }
   /* the neighbour rows are done with (the adjacency holds the graph); the
    * global sign reads only each row's reach */
   dacpo_knn_graph_keep_farthest(&s->knn);
