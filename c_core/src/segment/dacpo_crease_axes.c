@@ -103,18 +103,19 @@ dacpo_crease_axes(const dacpo_cloud* cloud,
               cloud->nrm != NULL && (k == 0 || g->idx != NULL),
               DACPO_ERR_INVALID_ARGUMENT,
               "crease axes: NULL array");
-  double* prev = dacpo_malloc_array(3 * n, sizeof(double));
-  if (prev == NULL)
+  double* scratch = dacpo_malloc_array(3 * n, sizeof(double));
+  if (scratch == NULL)
     return DACPO_OOM(err);
-  memcpy(out, cloud->nrm, 3 * n * sizeof(double));
-  crease_job job = {g, n, k, prev, out};
+  /* the passes alternate between scratch and out, the last one into out */
+  crease_job job = {g, n, k, cloud->nrm, NULL};
   const size_t tasks = (n + CREASE_CHUNK - 1) / CREASE_CHUNK;
   dacpo_status st = DACPO_OK;
   for (int pass = 0; pass < CREASE_PASSES && st == DACPO_OK; ++pass) {
-    memcpy(prev, out, 3 * n * sizeof(double));
+    job.out = (CREASE_PASSES - pass) % 2 ? out : scratch;
     st = dacpo_parallel_for(
         tasks, num_threads, crease_task, &job, NULL, DACPO_STAGE_SEGMENT, err);
+    job.in = job.out;
   }
-  free(prev);
+  free(scratch);
   return st;
 }
