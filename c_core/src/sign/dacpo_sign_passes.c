@@ -223,9 +223,70 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 /* ---- relative sign of disconnected parts -------------------------------- */
 
+/* Two groups joined only by weak edges, but by enough of them that the net
+ * evidence for the relation stage 5 gave them (per edge alpha if the blocks
+ * kept their relative sign, alpha_bar if one turned, minus the other) reaches
+ * one weak edge's worth, are one part: each seam is a few pixels, together
+ * they are a contact. Repeated until no two groups join (a join adds up the
+ * seams of the merged groups). */
+typedef struct group_pair {
+  uint64_t key; /* smaller root << 32 | larger root */
+  size_t edge;  /* ties in edge order: the sums do not depend on qsort */
+  double net;   /* evidence for stage 5's relation, minus against it */
+} group_pair;
+
+static int
+cmp_group_pair(const void* x, const void* y)
+{
+  const group_pair* a = x;
+  const group_pair* b = y;
+  if (a->key != b->key)
+    return a->key < b->key ? -1 : 1;
+  return (a->edge > b->edge) - (a->edge < b->edge);
+}
+
+static dacpo_status
+merge_by_summed_evidence(run_state* s, double weak, int32_t* root, dacpo_err* err)
+{
+  const size_t ne = s->bgraph.num_edges;
+  group_pair* gp = dacpo_malloc_array(ne ? ne : 1, sizeof(group_pair));
+  if (!gp)
+    return DACPO_OOM(err);
+  for (int joined = 1; joined;) {
+    joined = 0;
+    size_t m = 0;
+    for (size_t e = 0; e < ne; ++e) {
+      const dacpo_block_edge* be = &s->bgraph.edges[e];
+      const int32_t ra = dacpo_uf_find(root, be->a), rb = dacpo_uf_find(root, be->b);
+      if (ra == rb)
+        continue;
+      const int same = s->flips[be->a] == s->flips[be->b];
+      const uint32_t lo = (uint32_t)(ra < rb ? ra : rb), hi = (uint32_t)(ra < rb ? rb : ra);
+      gp[m].key = (uint64_t)lo << 32 | hi;
+      gp[m].edge = e;
+      gp[m++].net = same ? be->alpha - be->alpha_bar : be->alpha_bar - be->alpha;
+    }
+    qsort(gp, m, sizeof(group_pair), cmp_group_pair);
+    for (size_t i = 0; i < m;) {
+      size_t j = i;
+      double net = 0.0;
+      for (; j < m && gp[j].key == gp[i].key; ++j)
+        net += gp[j].net;
+      if (net >= weak * s->evidence_scale) {
+        dacpo_uf_union(root, (int32_t)(gp[i].key >> 32), (int32_t)(gp[i].key & 0xffffffffu));
+        joined = 1;
+      }
+      i = j;
+    }
+  }
+  free(gp);
+  return DACPO_OK;
+}
+
 /* Parts whose sign the viewpoint vote decides: the blocks joined by block-graph
- * edges that carry at least `weak` times the typical evidence (so never across
- * components). With weak = 0 the parts are the k-NN components. */
+ * edges that carry at least `weak` times the typical evidence, or by weaker
+ * ones whose net evidence adds up to as much (merge_by_summed_evidence; never
+ * across components). With weak = 0 the parts are the k-NN components. */
 static dacpo_status
 label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
 {
@@ -252,6 +313,12 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
     if (!(be->alpha + be->alpha_bar >= weak * s->evidence_scale))
       continue;
     dacpo_uf_union(root, be->a, be->b);
+  }
+  const dacpo_status st = merge_by_summed_evidence(s, weak, root, err);
+  if (st != DACPO_OK) {
+    free(root);
+    free(id);
+    return st;
   }
   size_t m = 0;
   for (size_t b = 0; b < nb; ++b)
