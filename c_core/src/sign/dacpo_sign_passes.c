@@ -226,9 +226,10 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 /* Two groups joined only by weak edges, but by enough of them that the net
  * evidence for the relation stage 5 gave them (per edge alpha if the blocks
  * kept their relative sign, alpha_bar if one turned, minus the other) reaches
- * one weak edge's worth, are one part: each seam is a few pixels, together
- * they are a contact. Repeated until no two groups join (a join adds up the
- * seams of the merged groups). */
+ * what one edge needs to join them (weak x the typical evidence), are one
+ * part: each seam is a few pixels of contact, together they are a contact.
+ * Repeated until no two groups join (a join adds up the seams of the merged
+ * groups). */
 typedef struct group_pair {
   uint64_t key; /* smaller root << 32 | larger root */
   size_t edge;  /* ties in edge order: the sums do not depend on qsort */
