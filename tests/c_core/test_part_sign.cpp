@@ -149,27 +149,39 @@ closedAndOpenShapes()
   return s;
 }
 
+// The floor the objects stand on (part q): a 50 x 2 m strip below them, the
+// scene against which they are object-sized.
+void
+addFloor(Shapes& s, int32_t q)
+{
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 5; ++j)
+      s.add(-5.0 + 0.5 * i, -1.0 + 0.5 * j, -1.0, 0.0, 0.0, 1.0, q);
+}
+
 TEST(PartSign, ClosedPartsAreToldFromOpenOnesAndSayWhichWayIsOut)
 {
   Shapes s = closedAndOpenShapes();
+  addFloor(s, 4);
   const size_t n = s.part.size();
-  int8_t outward[4];
+  int8_t outward[5];
   dacpo_err err = {DACPO_OK, {0}};
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 4, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 5, outward, &err),
             DACPO_OK)
       << err.msg;
   EXPECT_EQ(outward[0], 1) << "sphere, outward normals";
   EXPECT_EQ(outward[1], 0) << "a cap does not wrap around its centroid";
   EXPECT_EQ(outward[2], 0) << "a tube's two walls face both ways";
   EXPECT_EQ(outward[3], 0) << "flat";
+  EXPECT_EQ(outward[4], 0) << "the floor";
   // the same sphere inside out
   for (size_t i = 0; i < n; ++i)
     if (s.part[i] == 0)
       for (int d = 0; d < 3; ++d)
         s.nrm[3 * i + d] = -s.nrm[3 * i + d];
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 4, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 5, outward, &err),
             DACPO_OK);
   EXPECT_EQ(outward[0], -1) << "sphere, inward normals";
   EXPECT_EQ(outward[1], 0);
@@ -199,11 +211,12 @@ TEST(PartSign, SlabPartsSayWhichWayIsOut)
       if (i >= 10 && i < 20 && j >= 5 && j < 15)
         s.add(25.01 + x, y + 0.01, 0.03, 0.0, 0.0, 1.0, 5); // the picture's front
     }
+  addFloor(s, 6);
   const size_t n = s.part.size();
-  int8_t outward[6];
+  int8_t outward[7];
   dacpo_err err = {DACPO_OK, {0}};
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 6, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 7, outward, &err),
             DACPO_OK)
       << err.msg;
   EXPECT_EQ(outward[4], 1) << "board, faces looking away from each other";
@@ -215,7 +228,7 @@ TEST(PartSign, SlabPartsSayWhichWayIsOut)
       for (int d = 0; d < 3; ++d)
         s.nrm[3 * i + d] = -s.nrm[3 * i + d];
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 6, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 7, outward, &err),
             DACPO_OK);
   EXPECT_EQ(outward[4], -1) << "board inside out";
   EXPECT_EQ(outward[5], 0) << "the wall the other way round: still one face";
@@ -279,6 +292,55 @@ TEST(PartSign, DISABLED_AnObjectInsideTheRoomIsNotSeenFromItsInside)
     EXPECT_EQ(sign[1] * given, 1.0) << "the table faces up";
     EXPECT_GT(conf[1], 0.5);
   }
+}
+
+// An open room (floor and four walls, 4 x 3 x 2.5 m, normals facing in) at
+// `x0` as part q, sampled on a 10 cm grid.
+void
+addOpenRoom(Shapes& s, double x0, int32_t q)
+{
+  const double W = 4.0, D = 3.0, H = 2.5, h = 0.1;
+  for (double u = 0.05; u < W; u += h) {
+    for (double v = 0.05; v < D; v += h)
+      s.add(x0 + u, v, 0.0, 0.0, 0.0, 1.0, q);
+    for (double v = 0.05; v < H; v += h) {
+      s.add(x0 + u, 0.0, v, 0.0, 1.0, 0.0, q);
+      s.add(x0 + u, D, v, 0.0, -1.0, 0.0, q);
+    }
+  }
+  for (double u = 0.05; u < D; u += h)
+    for (double v = 0.05; v < H; v += h) {
+      s.add(x0, u, v, 1.0, 0.0, 0.0, q);
+      s.add(x0 + W, u, v, -1.0, 0.0, 0.0, q);
+    }
+}
+
+// Two rooms scanned apart (100 m between them) wrap around their centroids
+// with their normals facing in, like a closed object turned inside out; in
+// the box of the whole cloud each is small. Against the widest part they are
+// not objects, and stay with the viewpoint vote; a 30 cm sphere beside the
+// second room still is one.
+TEST(PartSign, RoomsFarApartAreNotObjects)
+{
+  Shapes s;
+  addOpenRoom(s, 0.0, 0);
+  addOpenRoom(s, 100.0, 1);
+  const double golden = 2.399963229728653;
+  for (int k = 0; k < 600; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / 600, r = std::sqrt(1.0 - z * z);
+    const double x = r * std::cos(golden * k), y = r * std::sin(golden * k);
+    s.add(106.0 + 0.3 * x, 1.5 + 0.3 * y, 1.0 + 0.3 * z, x, y, z, 2);
+  }
+  const size_t n = s.part.size();
+  int8_t outward[3] = {5, 5, 5};
+  dacpo_err err = {DACPO_OK, {0}};
+  ASSERT_EQ(dacpo_part_closed_outward(
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 3, outward, &err),
+            DACPO_OK)
+      << err.msg;
+  EXPECT_EQ(outward[0], 0) << "first room";
+  EXPECT_EQ(outward[1], 0) << "second room, 100 m away";
+  EXPECT_EQ(outward[2], 1) << "a sphere is an object";
 }
 
 TEST(PartSign, ClosedPartsRefuseNullInput)

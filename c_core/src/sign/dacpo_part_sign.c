@@ -281,12 +281,24 @@ dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, doubl
  * frame: the crown 22 cells, cosine -0.94 (inward) on all three of its
  * rooms; every other part below 20 cells or 0.45, except one of 24 cells at
  * +0.95 (already outward). Only object-sized parts (bounding box diagonal at
- * most CLOSED_MAX_EXTENT of the whole cloud's): a closed room seen from
- * inside (a closet with a ceiling, disconnected from the rest) wraps around
- * its centroid too, with its normals rightly facing in. */
+ * most CLOSED_MAX_EXTENT of the widest part's, the room they stand in): a
+ * room seen from inside (a closet with a ceiling, disconnected from the rest;
+ * an open room) wraps around its centroid too, with its normals rightly
+ * facing in. Against the whole cloud's box, two rooms scanned 100 m apart
+ * were each small, and the second came out inside out. */
 #define CLOSED_MIN_CELLS 20
 #define CLOSED_MIN_COS 0.7
 #define CLOSED_MAX_EXTENT 0.25
+
+/* Squared diagonal of part q's bounding box (0 for an empty part). */
+static double
+part_extent2(const double* lo, const double* hi, const double* count, size_t q)
+{
+  double e = 0.0;
+  for (int d = 0; count[q] > 0.0 && d < 3; ++d)
+    e += (hi[3 * q + d] - lo[3 * q + d]) * (hi[3 * q + d] - lo[3 * q + d]);
+  return e;
+}
 
 /* A flat part with two faces (a partition, a board standing free) is not
  * closed in the sense above (seen from its centroid it fills ~8 of the 26
@@ -337,9 +349,7 @@ slab_parts_outward(const double* xyz,
     m[5] += r[2] * r[2];
   }
   for (size_t q = 0; q < num_parts; ++q) {
-    double extent = 0.0;
-    for (int d = 0; d < 3; ++d)
-      extent += (hi[3 * q + d] - lo[3 * q + d]) * (hi[3 * q + d] - lo[3 * q + d]);
+    const double extent = part_extent2(lo, hi, count, q);
     if (outward[q] != 0 || count[q] < SLAB_MIN_POINTS ||
         !(extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all))
       continue;
@@ -381,7 +391,7 @@ slab_parts_outward(const double* xyz,
   }
 }
 
-/* Per part its centroid, point count and bounding box; the whole cloud's box. */
+/* Per part its centroid, point count and bounding box. */
 static void
 part_boxes(const double* xyz,
            size_t n,
@@ -390,9 +400,7 @@ part_boxes(const double* xyz,
            double* centre,
            double* count,
            double* lo,
-           double* hi,
-           double all_lo[3],
-           double all_hi[3])
+           double* hi)
 {
   for (size_t i = 0; i < n; ++i) {
     const size_t q = (size_t)part[i];
@@ -401,8 +409,6 @@ part_boxes(const double* xyz,
       centre[3 * q + d] += x;
       lo[3 * q + d] = fmin(lo[3 * q + d], x);
       hi[3 * q + d] = fmax(hi[3 * q + d], x);
-      all_lo[d] = fmin(all_lo[d], x);
-      all_hi[d] = fmax(all_hi[d], x);
     }
     count[q] += 1.0;
   }
@@ -435,16 +441,12 @@ dacpo_part_closed_outward(const double* xyz,
     return DACPO_OOM(err);
   }
   double *centre = acc, *cosine = acc + 3 * num_parts, *count = acc + 4 * num_parts;
-  double *lo = acc + 5 * num_parts, *hi = acc + 8 * num_parts, all_lo[3], all_hi[3];
-  for (int d = 0; d < 3; ++d) {
-    all_lo[d] = HUGE_VAL;
-    all_hi[d] = -HUGE_VAL;
-  }
+  double *lo = acc + 5 * num_parts, *hi = acc + 8 * num_parts;
   for (size_t q = 0; q < 3 * num_parts; ++q) {
     lo[q] = HUGE_VAL;
     hi[q] = -HUGE_VAL;
   }
-  part_boxes(xyz, n, part, num_parts, centre, count, lo, hi, all_lo, all_hi);
+  part_boxes(xyz, n, part, num_parts, centre, count, lo, hi);
   for (size_t i = 0; i < n; ++i) {
     const size_t q = (size_t)part[i];
     const double* c = centre + 3 * q;
@@ -458,16 +460,16 @@ dacpo_part_closed_outward(const double* xyz,
       cell = 3 * cell + (r[d] > 0.5 * len ? 2 : (r[d] < -0.5 * len ? 0 : 1));
     cells[q] |= 1u << cell;
   }
+  /* "object-sized" against the widest part, not the cloud's box: two rooms
+   * far apart make a box in which either room is small */
   double all = 0.0;
-  for (int d = 0; n > 0 && d < 3; ++d)
-    all += (all_hi[d] - all_lo[d]) * (all_hi[d] - all_lo[d]);
+  for (size_t q = 0; q < num_parts; ++q)
+    all = fmax(all, part_extent2(lo, hi, count, q));
   for (size_t q = 0; q < num_parts; ++q) {
     int filled = 0;
     for (uint32_t m = cells[q]; m; m &= m - 1)
       ++filled;
-    double extent = 0.0;
-    for (int d = 0; count[q] > 0.0 && d < 3; ++d)
-      extent += (hi[3 * q + d] - lo[3 * q + d]) * (hi[3 * q + d] - lo[3 * q + d]);
+    const double extent = part_extent2(lo, hi, count, q);
     const double mc = count[q] > 0.0 ? cosine[q] / count[q] : 0.0;
     if (filled >= CLOSED_MIN_CELLS && fabs(mc) >= CLOSED_MIN_COS &&
         extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all)
