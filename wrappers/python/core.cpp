@@ -253,6 +253,7 @@ statsDict(const dacpo_stats* s)
   stats["cue_anchored_blocks"] = s->cue_anchored_blocks;
   stats["parts_cue_signed"] = s->parts_cue_signed;
   stats["surface_vote_turned"] = s->surface_vote_turned;
+  stats["sensor_turned"] = s->sensor_turned;
   stats["cue_reconciled_blocks"] = s->cue_reconciled_blocks;
   stats["view_score"] = s->view_score;
   stats["sign_flipped"] = s->sign_flipped != 0;

@@ -239,7 +239,7 @@ printStats(const Result& result)
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu scan=%s single_view_fit=%.3f c=%g "
+               "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu sensor_turned=%zu scan=%s single_view_fit=%.3f c=%g "
                "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
@@ -259,6 +259,7 @@ printStats(const Result& result)
                s.parts_cue_signed,
                s.cue_reconciled_blocks,
                s.surface_vote_turned,
+               s.sensor_turned,
                s.scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single" : "multi",
                s.single_view_fit,
                s.dipole_c_used,

@@ -34,23 +34,29 @@ dacpo_view_log_density(const dacpo_view_sample* s,
  * fused TSDF fragment at 0.17, but with slopes of 0.08-0.11, so they get 0:
  * candidates whose density follows the model with a regression slope under
  * DACPO_SINGLE_VIEW_SLOPE do not count. *slope (may be NULL) gets the chosen
- * one's. xyz, axes: n points and unit axes (3n each).
+ * one's. sensor (may be NULL) gets where the sensor stands: the position
+ * whose model explains the densities best (least variance of log density
+ * minus the model: the candidate with the least, refined when *fit reaches
+ * DACPO_SINGLE_VIEW_FIT); it may lie on either side of the surfaces, the
+ * densities do not say which way they face. xyz, axes: n points and unit
+ * axes (3n each).
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
-dacpo_single_view_fit(const double* xyz,
-                      const double* axes,
-                      size_t n,
-                      const float* knn_sqd,
-                      size_t knn_k,
-                      double* fit,
-                      double* slope,
-                      dacpo_err* err);
+dacpo_single_view_sensor(const double* xyz,
+                         const double* axes,
+                         size_t n,
+                         const float* knn_sqd,
+                         size_t knn_k,
+                         double* fit,
+                         double* slope,
+                         double sensor[3],
+                         dacpo_err* err);
 
 /* The fit from which a cloud counts as one depth view (the global sign uses the
  * same threshold to single out a sensor). */
 #define DACPO_SINGLE_VIEW_FIT 0.5
 /* The least slope of log density on the sensor model for a candidate to count
- * (dacpo_single_view_fit). */
+ * (dacpo_single_view_sensor). */
 #define DACPO_SINGLE_VIEW_SLOPE 0.4
 
 #endif

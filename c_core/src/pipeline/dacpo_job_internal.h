@@ -46,7 +46,10 @@ typedef struct run_state {
   int8_t* part_sign;     /* per part */
   double* part_conf;     /* per part */
   double global_sign;    /* +1 or -1: stage 6 */
-  uint8_t* turned;       /* n: 1 where the surface vote turned the point over, or NULL */
+  uint8_t* turned;       /* n: 1 where the surface vote or the sensor turned the
+                            point over, or NULL */
+  int sensor_known;      /* 1: one depth view whose sensor stage 0 found */
+  double sensor[3];      /* that sensor's position (either side of the surfaces) */
   dacpo_ilp_result ilp;
   /* what the work units have done (dacpo_advanced.h checks the order) */
   uint8_t* block_done; /* per block: stages 2-3 */

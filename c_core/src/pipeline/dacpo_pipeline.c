@@ -598,19 +598,21 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->layered_share = 0.0;
   st->layered_copies = 0.0;
   st->layered_doubled = 0.0;
+  /* the sensor's fit and position: for the kind (AUTO) and, in one view, for
+   * the last sign pass, which turns the points it sees squarely to face it */
+  if (s->p.scan_kind != DACPO_SCAN_MULTI_VIEW)
+    DACPO_TRY(dacpo_single_view_sensor(s->cloud.xyz,
+                                       s->cloud.nrm,
+                                       s->cloud.n,
+                                       s->knn.sqd,
+                                       s->knn.k,
+                                       &st->single_view_fit,
+                                       NULL,
+                                       s->sensor,
+                                       err));
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
-    double fit = 0.0, slope = 0.0;
-    DACPO_TRY(dacpo_single_view_fit(s->cloud.xyz,
-                                    s->cloud.nrm,
-                                    s->cloud.n,
-                                    s->knn.sqd,
-                                    s->knn.k,
-                                    &fit,
-                                    &slope,
-                                    err));
-    st->single_view_fit = fit;
-    s->p.scan_kind =
-        fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW : DACPO_SCAN_MULTI_VIEW;
+    s->p.scan_kind = st->single_view_fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW
+                                                                 : DACPO_SCAN_MULTI_VIEW;
     /* Many views whose surfaces come as offset copies (fused with a
      * registration error): the thin-part rules would read each pair of copies
      * as a thin solid's two faces (dacpo_layered.c), so they are left out. A
@@ -640,6 +642,8 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
     }
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;
+  s->sensor_known = single && st->single_view_fit >= DACPO_SINGLE_VIEW_FIT &&
+                    s->p.sign_policy == DACPO_SIGN_FREE_SPACE;
   if (s->p.dipole_layers < 0.0) /* layers 0.5 spacings apart are depth steps */
     s->p.dipole_layers = single ? 0.5 : 2.0;
   /* One view shows no part from both sides: c = 1 drops Eq. 1's stacked vote

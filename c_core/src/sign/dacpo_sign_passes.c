@@ -21,7 +21,9 @@
  *   7 cue vs space     block flips where the cue and the free space disagree
  *                      within a part (the only pass after 2 that flips blocks)
  *   8 surface vote     per-point turns: large smooth surfaces keep one
- *                      orientation (the last word, point by point)
+ *                      orientation
+ *   9 sensor           per-point turns: in one depth view, every point its
+ *                      sensor sees squarely faces it (the last word)
  */
 #include <dacpo/dacpo_advanced.h>
 
@@ -700,6 +702,59 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
 }
 
 
+/* One depth view: its sensor saw every point from the side the point's
+ * normal must face, so where stage 0 found the sensor (the sampling density
+ * of a depth frame, dacpo_view_kind.c) a point it sees squarely takes that
+ * side, whatever stages 2-6 gave it. Stage 2 relates neighbours, and where a
+ * frame is noisy or far its blocks can come out partly reversed, square to
+ * the sensor as often as not. "Squarely": incidence under 60 degrees
+ * (DACPO_SENSOR_SQUARE_COS); nearer grazing the estimated axis and the
+ * estimated sensor decide less surely, and scans of many nearby views that
+ * pass for one view (a room swept by one camera) hold surfaces seen from
+ * other places, which face away from the sensor obliquely (docs/DESIGN.md,
+ * "One view faces its sensor"). The density does not say on which side of
+ * the surfaces the sensor stands: when most squarely seen points face away
+ * from the position found, it is the mirror image and nothing turns. */
+#define DACPO_SENSOR_SQUARE_COS 0.5
+
+/* +1 / -1: point i's output normal (its axis, signed as the run signs it now)
+ * faces the sensor squarely / faces away squarely; 0: seen near grazing. */
+static int
+sensor_side(const run_state* s, size_t i)
+{
+  const double* p = s->cloud.xyz + 3 * i;
+  const double* a = s->cloud.nrm + 3 * i;
+  const double* o = s->oriented + 3 * i;
+  const double r[3] = {s->sensor[0] - p[0], s->sensor[1] - p[1], s->sensor[2] - p[2]};
+  const double along = a[0] * o[0] + a[1] * o[1] + a[2] * o[2] >= 0.0 ? 1.0 : -1.0;
+  const double dot = along * dacpo_sign_point(s, i) * (a[0] * r[0] + a[1] * r[1] + a[2] * r[2]);
+  const double len =
+      sqrt((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+  return dot >= DACPO_SENSOR_SQUARE_COS * len ? 1 : (dot <= -DACPO_SENSOR_SQUARE_COS * len ? -1 : 0);
+}
+
+static void
+face_the_sensor(run_state* s, dacpo_stats* st)
+{
+  const size_t n = s->cloud.n;
+  st->sensor_turned = 0;
+  if (!s->sensor_known || !s->turned)
+    return;
+  size_t facing = 0, away = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const int side = sensor_side(s, i);
+    facing += side > 0;
+    away += side < 0;
+  }
+  if (away >= facing)
+    return;
+  for (size_t i = 0; i < n; ++i)
+    if (sensor_side(s, i) < 0) {
+      s->turned[i] = (uint8_t)!s->turned[i];
+      ++st->sensor_turned;
+    }
+}
+
 dacpo_status
 dacpo_sign_passes(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
@@ -714,5 +769,12 @@ dacpo_sign_passes(run_state* s, dacpo_stats* st, dacpo_err* err)
   if (s->part_sign)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   DACPO_TRY(reconcile_cue_with_free_space(s, &st->cue_reconciled_blocks, err));
-  return surface_vote(s, st, err);
+  DACPO_TRY(surface_vote(s, st, err));
+  if (s->sensor_known && !s->turned) {
+    s->turned = dacpo_calloc_array(s->cloud.n, sizeof(uint8_t));
+    if (!s->turned)
+      return DACPO_OOM(err);
+  }
+  face_the_sensor(s, st);
+  return DACPO_OK;
 }

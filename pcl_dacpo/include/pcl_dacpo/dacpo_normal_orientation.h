@@ -419,7 +419,8 @@ public:
 
   /** \brief Which of the two consistent orientations to return (default
    *  SignPolicy::FreeSpace: normals face the free space the scan was seen from,
-   *  no sensor position needed; closed objects get outward normals). */
+   *  no sensor position needed; closed objects get outward normals; in a
+   *  single depth view every point its sensor sees squarely faces it). */
   void
   setSignPolicy(SignPolicy policy)
   {
