@@ -136,8 +136,9 @@ typedef enum dacpo_sign_policy {
    *  that most normals face and that sees most of the scene (normals face
    *  away from it when it lies inside a closed surface: objects come out
    *  with outward normals). No sensor position needed. In a single depth
-   *  view the sensor is placed by the sampling density, and every point it
-   *  sees within 60 degrees of its normal is turned to face it. */
+   *  view whose sampling density places its sensor well (single_view_fit
+   *  >= 0.7), every point the sensor sees within 60 degrees of its normal is
+   *  turned to face it. */
   DACPO_SIGN_FREE_SPACE = 0,
   /** Most normals face dacpo_params::viewpoint (a sensor origin); one sign
    *  for the whole cloud, so consistency is kept. */
@@ -269,10 +270,11 @@ typedef struct dacpo_stats {
                                    turned after the viewpoint vote and stage 6 */
   size_t surface_vote_turned; /**< distinct points the surface vote turned over
                                    (dacpo_params.surface_vote) */
-  size_t sensor_turned;       /**< one depth view whose sensor the FREE_SPACE sign
-                                   singled out: distinct points turned to face it
-                                   (those it sees within 60 degrees of their
-                                   normal), after every other pass */
+  size_t sensor_turned;       /**< FREE_SPACE, one depth view whose density places
+                                   its sensor (single_view_fit >= 0.7): distinct
+                                   points turned to face it (those it sees within
+                                   60 degrees of their normal), after every other
+                                   pass */
   size_t cue_reconciled_blocks; /**< blocks turned after stage 6 where their side
                                      cue and the free space disagreed (groups of
                                      blocks against their cue whose anchors
@@ -280,9 +282,9 @@ typedef struct dacpo_stats {
   dacpo_scan_kind scan_kind;  /**< the kind the run used (never AUTO) */
   double single_view_fit;     /**< AUTO or SINGLE_VIEW: how well one sensor position
                                    explains the sampling density (correlation,
-                                   -1..1; >= 0.5: single view, whose sensor the
-                                   last sign pass uses); 0 when MULTI_VIEW was
-                                   given */
+                                   -1..1; >= 0.5: single view; >= 0.7: the last
+                                   sign pass uses its sensor); 0 when MULTI_VIEW
+                                   was given */
   double dipole_c_used;       /**< dipole_c the run used (resolved when < 0) */
   double dipole_layers_used;  /**< dipole_layers the run used (resolved when < 0) */
   double dipole_two_sheet_used; /**< dipole_two_sheet the run used (resolved when < 0) */

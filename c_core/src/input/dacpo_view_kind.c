@@ -208,7 +208,7 @@ dacpo_single_view_sensor(const double* xyz,
     }
   }
   *fit = best;
-  if (sensor && best >= DACPO_SINGLE_VIEW_FIT)
+  if (sensor && best >= DACPO_SENSOR_FIT)
     refine_sensor(&vs, logd, sensor);
   free(logd);
   dacpo_view_sample_free(&vs);

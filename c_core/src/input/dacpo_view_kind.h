@@ -37,7 +37,7 @@ dacpo_view_log_density(const dacpo_view_sample* s,
  * one's. sensor (may be NULL) gets where the sensor stands: the position
  * whose model explains the densities best (least variance of log density
  * minus the model: the candidate with the least, refined when *fit reaches
- * DACPO_SINGLE_VIEW_FIT); it may lie on either side of the surfaces, the
+ * DACPO_SENSOR_FIT); it may lie on either side of the surfaces, the
  * densities do not say which way they face. xyz, axes: n points and unit
  * axes (3n each).
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
@@ -55,6 +55,13 @@ dacpo_single_view_sensor(const double* xyz,
 /* The fit from which a cloud counts as one depth view (the global sign uses the
  * same threshold to single out a sensor). */
 #define DACPO_SINGLE_VIEW_FIT 0.5
+/* The fit from which the sensor found is trusted point by point (the last
+ * sign pass turns the points it sees squarely to face it): a view the density
+ * explains well, not a scan of many views that passes for one (their sensor
+ * found is a compromise, and other cameras saw surfaces that face away from
+ * it). Below it the view keeps the pipeline's signs (docs/DESIGN.md, "One
+ * view faces its sensor"). */
+#define DACPO_SENSOR_FIT 0.7
 /* The least slope of log density on the sensor model for a candidate to count
  * (dacpo_single_view_sensor). */
 #define DACPO_SINGLE_VIEW_SLOPE 0.4

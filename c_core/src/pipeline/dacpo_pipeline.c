@@ -642,7 +642,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
     }
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;
-  s->sensor_known = single && st->single_view_fit >= DACPO_SINGLE_VIEW_FIT &&
+  s->sensor_known = single && st->single_view_fit >= DACPO_SENSOR_FIT &&
                     s->p.sign_policy == DACPO_SIGN_FREE_SPACE;
   if (s->p.dipole_layers < 0.0) /* layers 0.5 spacings apart are depth steps */
     s->p.dipole_layers = single ? 0.5 : 2.0;

@@ -703,18 +703,16 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 
 /* One depth view: its sensor saw every point from the side the point's
- * normal must face, so where stage 0 found the sensor (the sampling density
- * of a depth frame, dacpo_view_kind.c) a point it sees squarely takes that
- * side, whatever stages 2-6 gave it. Stage 2 relates neighbours, and where a
- * frame is noisy or far its blocks can come out partly reversed, square to
- * the sensor as often as not. "Squarely": incidence under 60 degrees
- * (DACPO_SENSOR_SQUARE_COS); nearer grazing the estimated axis and the
- * estimated sensor decide less surely, and scans of many nearby views that
- * pass for one view (a room swept by one camera) hold surfaces seen from
- * other places, which face away from the sensor obliquely (docs/DESIGN.md,
- * "One view faces its sensor"). The density does not say on which side of
- * the surfaces the sensor stands: when most squarely seen points face away
- * from the position found, it is the mirror image and nothing turns. */
+ * normal must face, so where stage 0 found the sensor (a depth frame whose
+ * density fits it by DACPO_SENSOR_FIT, dacpo_view_kind.c) a point it sees
+ * squarely takes that side, whatever stages 2-6 gave it. Stage 2 relates
+ * neighbours, and where a frame is noisy or far its blocks can come out
+ * partly reversed, square to the sensor as often as not. "Squarely":
+ * incidence under 60 degrees (DACPO_SENSOR_SQUARE_COS); nearer grazing the
+ * estimated axis and the estimated sensor decide less surely (docs/DESIGN.md,
+ * "One view faces its sensor"). The density does not say on which side of the
+ * surfaces the sensor stands: when most squarely seen points face away from
+ * the position found, it is the mirror image and nothing turns. */
 #define DACPO_SENSOR_SQUARE_COS 0.5
 
 /* +1 / -1: point i's output normal (its axis, signed as the run signs it now)

@@ -420,7 +420,8 @@ public:
   /** \brief Which of the two consistent orientations to return (default
    *  SignPolicy::FreeSpace: normals face the free space the scan was seen from,
    *  no sensor position needed; closed objects get outward normals; in a
-   *  single depth view every point its sensor sees squarely faces it). */
+   *  single depth view whose density places its sensor well, every point the
+   *  sensor sees squarely faces it). */
   void
   setSignPolicy(SignPolicy policy)
   {
