@@ -115,18 +115,30 @@ sensor_spread(const dacpo_view_sample* s, const double* logd, const double v[3])
   return sq / m - (sum / m) * (sum / m);
 }
 
-/* The candidates lie on a coarse lattice of pushes along sample normals; the
- * least spread around the best of them is found by a compass search (steps
- * along the axes, halved when none helps) down to 1e-4 scene diameters. The
- * correlation finds one view; the spread places its sensor (on real frames a
- * few decimetres from the true one, against up to 1.8 m for the best
- * candidate). */
+/* The sensor of a view that fits: the candidate (a coarse lattice of pushes
+ * along sample normals) with the least spread, then a compass search around
+ * it (steps along the axes, halved when none helps) down to 1e-4 scene
+ * diameters. The correlation finds one view; the spread places its sensor
+ * (on real frames a few decimetres from the true one, against up to 1.8 m for
+ * the best-correlated candidate). */
 #define DACPO_SENSOR_SEARCH_EVALS 600
 
 static void
-refine_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
+place_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
 {
-  double cur = sensor_spread(s, logd, v);
+  dacpo_rng rng; /* the same candidates as the fit's */
+  dacpo_view_rng_seed(&rng);
+  double least = HUGE_VAL;
+  for (size_t k = 0; k < DACPO_VIEW_KIND_CANDIDATES; ++k) {
+    double c[3];
+    dacpo_view_candidate(s, &rng, k, c);
+    const double spread = sensor_spread(s, logd, c);
+    if (spread < least) {
+      least = spread;
+      memcpy(v, c, sizeof(c));
+    }
+  }
+  double cur = least;
   double h = s->diam / 8.0;
   for (size_t evals = 0; h > 1e-4 * s->diam && evals < DACPO_SENSOR_SEARCH_EVALS;) {
     int moved = 0;
@@ -182,17 +194,10 @@ dacpo_single_view_sensor(const double* xyz,
   }
   dacpo_rng rng;
   dacpo_view_rng_seed(&rng);
-  double best = 0.0, least_spread = HUGE_VAL;
+  double best = 0.0;
   for (size_t k = 0; k < DACPO_VIEW_KIND_CANDIDATES; ++k) {
     double v[3];
     dacpo_view_candidate(&vs, &rng, k, v);
-    if (sensor) {
-      const double spread = sensor_spread(&vs, logd, v);
-      if (spread < least_spread) {
-        least_spread = spread;
-        memcpy(sensor, v, sizeof(v));
-      }
-    }
     double b = 0.0;
     const double f = dacpo_view_density_fit(&vs, logd, v, &b);
     /* The density must follow the model, not only rise with it: on a small
@@ -209,7 +214,7 @@ dacpo_single_view_sensor(const double* xyz,
   }
   *fit = best;
   if (sensor && best >= DACPO_SENSOR_FIT)
-    refine_sensor(&vs, logd, sensor);
+    place_sensor(&vs, logd, sensor);
   free(logd);
   dacpo_view_sample_free(&vs);
   return DACPO_OK;

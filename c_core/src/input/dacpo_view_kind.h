@@ -34,12 +34,12 @@ dacpo_view_log_density(const dacpo_view_sample* s,
  * fused TSDF fragment at 0.17, but with slopes of 0.08-0.11, so they get 0:
  * candidates whose density follows the model with a regression slope under
  * DACPO_SINGLE_VIEW_SLOPE do not count. *slope (may be NULL) gets the chosen
- * one's. sensor (may be NULL) gets where the sensor stands: the position
- * whose model explains the densities best (least variance of log density
- * minus the model: the candidate with the least, refined when *fit reaches
- * DACPO_SENSOR_FIT); it may lie on either side of the surfaces, the
- * densities do not say which way they face. xyz, axes: n points and unit
- * axes (3n each).
+ * one's. sensor (may be NULL) gets, when *fit reaches DACPO_SENSOR_FIT,
+ * where the sensor stands: the position whose model explains the densities
+ * best (least variance of log density minus the model: the candidate with
+ * the least, refined); else (0, 0, 0). It may lie on either side of the
+ * surfaces: the densities do not say which way they face. xyz, axes: n
+ * points and unit axes (3n each).
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_single_view_sensor(const double* xyz,
