@@ -731,13 +731,13 @@ sensor_side(const run_state* s, size_t i)
   return dot >= DACPO_SENSOR_SQUARE_COS * len ? 1 : (dot <= -DACPO_SENSOR_SQUARE_COS * len ? -1 : 0);
 }
 
-static void
-face_the_sensor(run_state* s, dacpo_stats* st)
+static dacpo_status
+face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
   const size_t n = s->cloud.n;
   st->sensor_turned = 0;
-  if (!s->sensor_known || !s->turned)
-    return;
+  if (!s->sensor_known)
+    return DACPO_OK;
   size_t facing = 0, away = 0;
   for (size_t i = 0; i < n; ++i) {
     const int side = sensor_side(s, i);
@@ -745,12 +745,15 @@ face_the_sensor(run_state* s, dacpo_stats* st)
     away += side < 0;
   }
   if (away >= facing)
-    return;
+    return DACPO_OK;
+  if (!s->turned && !(s->turned = dacpo_calloc_array(n ? n : 1, sizeof(uint8_t))))
+    return DACPO_OOM(err);
   for (size_t i = 0; i < n; ++i)
     if (sensor_side(s, i) < 0) {
       s->turned[i] = (uint8_t)!s->turned[i];
       ++st->sensor_turned;
     }
+  return DACPO_OK;
 }
 
 dacpo_status
@@ -768,11 +771,5 @@ dacpo_sign_passes(run_state* s, dacpo_stats* st, dacpo_err* err)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   DACPO_TRY(reconcile_cue_with_free_space(s, &st->cue_reconciled_blocks, err));
   DACPO_TRY(surface_vote(s, st, err));
-  if (s->sensor_known && !s->turned) {
-    s->turned = dacpo_calloc_array(s->cloud.n, sizeof(uint8_t));
-    if (!s->turned)
-      return DACPO_OOM(err);
-  }
-  face_the_sensor(s, st);
-  return DACPO_OK;
+  return face_the_sensor(s, st, err);
 }
