@@ -14,9 +14,9 @@
  * of an open room for a fused scan). Each part is consistent on its own, so v is the
  * point that explains the parts best when each may still flip: score(v) =
  * sum over parts of |facing - not facing| / sample size. Every part then takes
- * the sign under which most of its points face v, relative to the largest
- * part. The vote is per part: a part need not face v point by point, only on
- * the whole.
+ * the sign under which its points face v on the whole (their cosines with the
+ * direction to v summed), relative to the largest part. The vote is per part: a
+ * part need not face v point by point, only on the whole.
  *
  * v is searched among candidates p_i +- t n_i (sample points pushed to either
  * side of their normal by t = 1/4 .. 2 scene diameters); the best score is the
@@ -113,8 +113,16 @@ part_best_viewpoint(const dacpo_view_sample* vs,
   return facing;
 }
 
-/* Every point votes; the largest part keeps its sign (the others follow it),
- * so flip the votes when the largest one does not face v. */
+/* Every point votes with the cosine between its normal and the direction to
+ * v: a point v sees squarely counts fully, one it sees edge-on not at all. In
+ * a scan seen from many places the one viewpoint can stand in the plane of a
+ * part seen from elsewhere (a partition's face, v above its far edge): every
+ * point of it then faces away from v by a hair, and a vote of signs would
+ * turn the part over with a clear margin. By cosines the margin is the part's
+ * mean cosine, near 0 there, so the part keeps stage 5's weak relation
+ * (DACPO_PART_MIN_MARGIN, dacpo_sign_passes.c). The largest part keeps its
+ * sign (the others follow it), so flip the votes when the largest one does
+ * not face v. */
 static void
 part_signs_facing(const double* xyz,
                   const double* nrm,
@@ -132,8 +140,11 @@ part_signs_facing(const double* xyz,
   for (size_t i = 0; i < n; ++i) {
     const double* p = xyz + 3 * i;
     const double* q = nrm + 3 * i;
-    const double f = q[0] * (v[0] - p[0]) + q[1] * (v[1] - p[1]) + q[2] * (v[2] - p[2]);
-    vote[part[i]] += f > 0.0 ? 1.0 : f < 0.0 ? -1.0 : 0.0;
+    const double d[3] = {v[0] - p[0], v[1] - p[1], v[2] - p[2]};
+    const double len =
+        sqrt((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
+    if (len > 0.0)
+      vote[part[i]] += (q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / len;
   }
   const double ref = vote[big] < 0.0 ? -1.0 : 1.0;
   for (size_t c = 0; c < num_parts; ++c) {

@@ -225,6 +225,15 @@ solve_flips(run_state* s, dacpo_stats* st, dacpo_err* err)
 
 /* ---- relative sign of disconnected parts -------------------------------- */
 
+/* Evidence of block edge be for the relation stage 5 gave its blocks, minus
+ * the evidence against it. */
+static double
+stage5_evidence(const run_state* s, const dacpo_block_edge* be)
+{
+  return s->flips[be->a] == s->flips[be->b] ? be->alpha - be->alpha_bar
+                                            : be->alpha_bar - be->alpha;
+}
+
 /* Two groups joined only by weak edges, but by enough of them that the net
  * evidence for the relation stage 5 gave them (per edge alpha if the blocks
  * kept their relative sign, alpha_bar if one turned, minus the other) reaches
@@ -263,11 +272,10 @@ merge_by_summed_evidence(run_state* s, double weak, int32_t* root, dacpo_err* er
       const int32_t ra = dacpo_uf_find(root, be->a), rb = dacpo_uf_find(root, be->b);
       if (ra == rb)
         continue;
-      const int same = s->flips[be->a] == s->flips[be->b];
       const uint32_t lo = (uint32_t)(ra < rb ? ra : rb), hi = (uint32_t)(ra < rb ? rb : ra);
       gp[m].key = (uint64_t)lo << 32 | hi;
       gp[m].edge = e;
-      gp[m++].net = same ? be->alpha - be->alpha_bar : be->alpha_bar - be->alpha;
+      gp[m++].net = stage5_evidence(s, be);
     }
     qsort(gp, m, sizeof(group_pair), cmp_group_pair);
     for (size_t i = 0; i < m;) {
@@ -341,47 +349,88 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
 }
 
 /* A part that weak edges join to others in its component keeps the relation
- * stage 5 gave it to the component's largest part unless its own viewpoint vote
- * is clear (margin >= DACPO_PART_MIN_MARGIN): weak evidence is still evidence,
- * a near tie of the vote is not. The component's largest part follows the vote
- * (it has no other relation to the rest of the scene). */
+ * stage 5 gave it to the parts it touches unless its own viewpoint vote is
+ * clear (margin >= DACPO_PART_MIN_MARGIN): weak evidence is still evidence, a
+ * near tie of the vote is not. The component's largest part follows the vote
+ * (it has no other relation to the rest of the scene). The undecided parts
+ * are signed one at a time, the one whose seams to signed parts pull hardest
+ * first: a neighbour that the vote turned takes the relation along (keeping
+ * the relation to the largest part instead would break it at that seam). A
+ * part with no seam to a signed part keeps stage 5's relation to the largest
+ * part of its component. */
 #define DACPO_PART_MIN_MARGIN 0.3
+
+/* Signs the parts not marked in decided[] along their seams (see above);
+ * part_of[b]: the part of block b (-1: a block without points). pull: np
+ * scratch. */
+static void
+sign_along_seams(run_state* s, size_t np, const int32_t* part_of, uint8_t* decided, double* pull)
+{
+  for (;;) {
+    memset(pull, 0, np * sizeof(double));
+    for (size_t e = 0; e < s->bgraph.num_edges; ++e) {
+      const dacpo_block_edge* be = &s->bgraph.edges[e];
+      const int32_t qa = part_of[be->a], qb = part_of[be->b];
+      if (qa < 0 || qb < 0 || qa == qb || decided[qa] == decided[qb])
+        continue;
+      const int32_t q = decided[qa] ? qb : qa, r = decided[qa] ? qa : qb;
+      pull[q] += stage5_evidence(s, be) * (double)s->part_sign[r];
+    }
+    size_t best = np;
+    for (size_t q = 0; q < np; ++q)
+      if (!decided[q] && pull[q] != 0.0 && (best == np || fabs(pull[q]) > fabs(pull[best])))
+        best = q;
+    if (best == np)
+      return;
+    s->part_sign[best] = pull[best] > 0.0 ? 1 : -1;
+    decided[best] = 1;
+  }
+}
 
 static dacpo_status
 keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
 {
-  const size_t n = s->cloud.n;
+  const size_t n = s->cloud.n, nb = s->blocks.num_blocks;
   size_t* size = dacpo_calloc_array(np, sizeof(size_t));
   int32_t* comp = dacpo_malloc_array(np, sizeof(int32_t));
   int32_t* anchor = dacpo_malloc_array(s->num_components, sizeof(int32_t));
-  if (!size || !comp || !anchor) {
-    free(size);
-    free(comp);
-    free(anchor);
-    return DACPO_OOM(err);
-  }
-  for (size_t i = 0; i < n; ++i) {
+  int32_t* part_of = dacpo_malloc_array(nb ? nb : 1, sizeof(int32_t));
+  uint8_t* decided = dacpo_calloc_array(np, sizeof(uint8_t));
+  double* pull = dacpo_malloc_array(np, sizeof(double));
+  dacpo_status r = size && comp && anchor && part_of && decided && pull ? DACPO_OK : DACPO_OOM(err);
+  for (size_t b = 0; r == DACPO_OK && b < nb; ++b)
+    part_of[b] = -1;
+  for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
     size[s->part[i]]++;
     comp[s->part[i]] = s->input_component[i];
+    part_of[s->blocks.block_of[i]] = s->part[i];
   }
-  for (size_t c = 0; c < s->num_components; ++c)
+  for (size_t c = 0; r == DACPO_OK && c < s->num_components; ++c)
     anchor[c] = -1;
-  for (size_t q = 0; q < np; ++q)
+  for (size_t q = 0; r == DACPO_OK && q < np; ++q)
     if (size[q] > 0 && (anchor[comp[q]] < 0 || size[q] > size[anchor[comp[q]]]))
       anchor[comp[q]] = (int32_t)q;
-  for (size_t q = 0; q < np; ++q) {
-    const int32_t a = size[q] > 0 ? anchor[comp[q]] : (int32_t)q;
-    if (a != (int32_t)q && s->part_conf[q] < DACPO_PART_MIN_MARGIN) {
-      /* stage 5 holds it to the anchor: the block confidence speaks for
-       * that relation, the anchor's vote for the rest */
+  for (size_t q = 0; r == DACPO_OK && q < np; ++q)
+    decided[q] = size[q] == 0 || anchor[comp[q]] == (int32_t)q ||
+                 s->part_conf[q] >= DACPO_PART_MIN_MARGIN;
+  if (r == DACPO_OK)
+    sign_along_seams(s, np, part_of, decided, pull);
+  for (size_t q = 0; r == DACPO_OK && q < np; ++q) {
+    if (size[q] == 0 || anchor[comp[q]] == (int32_t)q || s->part_conf[q] >= DACPO_PART_MIN_MARGIN)
+      continue;
+    const int32_t a = anchor[comp[q]];
+    if (!decided[q]) /* no seam to a signed part */
       s->part_sign[q] = s->part_sign[a];
-      s->part_conf[q] = s->part_conf[a];
-    }
+    /* the block confidence speaks for its relation, the anchor's vote for the rest */
+    s->part_conf[q] = s->part_conf[a];
   }
   free(size);
   free(comp);
   free(anchor);
-  return DACPO_OK;
+  free(part_of);
+  free(decided);
+  free(pull);
+  return r;
 }
 
 /* A part holding blocks the side cue anchored has an absolute sign (stage 5
