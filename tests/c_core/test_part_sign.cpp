@@ -315,6 +315,41 @@ addOpenRoom(Shapes& s, double x0, int32_t q)
     }
 }
 
+// A partition 2 m long and 2 m high, 10 cm thick, both faces sampled (a part
+// of its own), standing in an open room of 4 x 3 x 2.5 m: it spans half the
+// room's diagonal, more than a closed part may to count as an object, yet
+// its faces look away from its mid-plane whatever its size. The room is not
+// a slab (its least spread is not thin against the next).
+TEST(PartSign, APartitionAsTallAsTheRoomIsASlab)
+{
+  Shapes s;
+  addOpenRoom(s, 0.0, 0);
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double y = 0.5 + 0.05 * i, z = 0.05 * j;
+      const double ripple = 0.001 * std::sin(1.7 * i + 2.3 * j);
+      s.add(1.95 - ripple, y, z, -1.0, 0.0, 0.0, 1);
+      s.add(2.05 + ripple, y + 0.025, z + 0.025, 1.0, 0.0, 0.0, 1);
+    }
+  const size_t n = s.part.size();
+  for (double given : {1.0, -1.0}) {
+    SCOPED_TRACE(given > 0.0 ? "partition handed over right" : "partition inside out");
+    std::vector<double> nrm = s.nrm;
+    for (size_t i = 0; i < n; ++i)
+      if (s.part[i] == 1)
+        for (int d = 0; d < 3; ++d)
+          nrm[3 * i + d] *= given;
+    int8_t outward[2] = {5, 5};
+    dacpo_err err = {DACPO_OK, {0}};
+    ASSERT_EQ(dacpo_part_closed_outward(
+                  s.xyz.data(), nrm.data(), n, s.part.data(), 2, outward, &err),
+              DACPO_OK)
+        << err.msg;
+    EXPECT_EQ(outward[1], given > 0.0 ? 1 : -1);
+    EXPECT_EQ(outward[0], 0) << "the room is neither closed nor a slab";
+  }
+}
+
 // Two rooms scanned apart (100 m between them) wrap around their centroids
 // with their normals facing in, like a closed object turned inside out; in
 // the box of the whole cloud each is small. Against the widest part they are

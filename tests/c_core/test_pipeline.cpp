@@ -414,6 +414,22 @@ TEST(DacpoPipeline, APartSeenEdgeOnKeepsItsSeams)
   }
 }
 
+// The same room of scene seed 6 on run seed 2: the viewpoint stands in the
+// room, the partition's two faces are one part, and its hidden face (5,894
+// points) outvoted its visible one (3,491): the part came out inside out.
+// A flat part with two faces looks away from its mid-plane whatever its
+// size; the partition spans 0.29 of the room's diagonal, above the quarter
+// up to which a closed part counts as an object, and was left to the vote.
+// Measured (run seeds 2 / 3): 11.11 / 10.95 -> 1.70 / 1.56 % wrong.
+TEST(DacpoPipeline, APartitionsFacesLookAwayFromEachOther)
+{
+  Result r;
+  double wrong = 100.0;
+  ASSERT_NO_FATAL_FAILURE(orientViewedRoom(6, 2, &r, &wrong));
+  printf("depth-camera room, scene seed 6, run seed 2: %.2f %% wrong\n", wrong);
+  EXPECT_LT(wrong, 5.0);
+}
+
 // A closed object that touches nothing (a ball hung above a room, sampled all
 // round) faces every viewpoint with half its points: the viewpoint vote that
 // relates disconnected parts cannot place it (without the closed-part rule it

@@ -322,7 +322,11 @@ part_extent2(const double* lo, const double* hi, const double* count, size_t q)
  * partition of 3,110 points, its own part with too few cue points to sign
  * it, was turned inside out by the viewpoint vote (a coin for a two-faced
  * board): its score was -0.985 (ground truth +0.907). A wall with a picture on
- * it has one face (n.t > 0 almost everywhere) and is left alone. */
+ * it has one face (n.t > 0 almost everywhere) and is left alone. Any size: a
+ * room is never this thin (its least spread, the height, is about half the
+ * next one), and a partition 1.8 m high in a 6 x 5 m room spans more than a
+ * quarter of the room, the size up to which a closed part counts as an
+ * object. */
 #define SLAB_MAX_THIN 0.25
 #define SLAB_FACE_COS 0.7
 #define SLAB_MIN_SIDE 0.25
@@ -339,9 +343,6 @@ slab_parts_outward(const double* xyz,
                    size_t num_parts,
                    const double* centre,
                    const double* count,
-                   const double* lo,
-                   const double* hi,
-                   double all,
                    double* acc,
                    int8_t* outward)
 {
@@ -360,9 +361,7 @@ slab_parts_outward(const double* xyz,
     m[5] += r[2] * r[2];
   }
   for (size_t q = 0; q < num_parts; ++q) {
-    const double extent = part_extent2(lo, hi, count, q);
-    if (outward[q] != 0 || count[q] < SLAB_MIN_POINTS ||
-        !(extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all))
+    if (outward[q] != 0 || count[q] < SLAB_MIN_POINTS)
       continue;
     const double* m = cov + 6 * q;
     double a[3][3] = {{m[0], m[1], m[2]}, {m[1], m[3], m[4]}, {m[2], m[4], m[5]}}, w[3],
@@ -486,8 +485,7 @@ dacpo_part_closed_outward(const double* xyz,
         extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all)
       outward[q] = mc > 0.0 ? 1 : -1;
   }
-  slab_parts_outward(
-      xyz, nrm, n, part, num_parts, centre, count, lo, hi, all, acc + 11 * num_parts, outward);
+  slab_parts_outward(xyz, nrm, n, part, num_parts, centre, count, acc + 11 * num_parts, outward);
   free(acc);
   free(cells);
   return DACPO_OK;

@@ -80,8 +80,9 @@ dacpo_view_rng_seed(dacpo_rng* rng);
 void
 dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, double v[3]);
 
-/* Parts that wrap around their own centroid (closed objects), and flat parts
- * with two faces (a free-standing board: its faces look away from its
+/* Parts that wrap around their own centroid (closed objects, at most a
+ * quarter of the widest part's size), and flat parts with two faces of any
+ * size (a free-standing board, a partition: its faces look away from its
  * mid-plane): outward[c] = +1 if their normals (nrm, as they will be returned)
  * face outward, -1 if inward, 0 for every other part. Failures: NULL argument (INVALID_ARGUMENT),
  * OUT_OF_MEMORY. */
