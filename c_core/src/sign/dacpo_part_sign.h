@@ -10,8 +10,8 @@
  * [0, num_parts) is the part of point i. Writes, per part, sign[c] in
  * {+1, -1} (multiply the part's normals by it; the largest part keeps +1) and
  * confidence[c] in [0, 1] (the vote margin: |mean cosine| between the part's
- * normals and the directions to the viewpoint; 1 for the largest part; 0 for all others when no viewpoint explains the scene,
- * then every sign stays +1). *score_out (may be NULL) gets the share of a
+ * normals and the directions to the viewpoint; 1 for the largest part; 0 for
+ * all others when no viewpoint explains the scene, then every sign stays +1). *score_out (may be NULL) gets the share of a
  * sample of the points that face the chosen viewpoint under their part's best
  * sign. The result does not depend on the run's seed.
  * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
