@@ -360,9 +360,9 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
  * part of its component. */
 #define DACPO_PART_MIN_MARGIN 0.3
 
-/* Signs the parts not marked in decided[] along their seams (see above);
- * part_of[b]: the part of block b (-1: a block without points). pull: np
- * scratch. */
+/* Signs the parts with decided[q] == 0 along their seams (see above) and
+ * marks them 1 (decided[] != 0: signed); part_of[b]: the part of block b (-1:
+ * a block without points). pull: np scratch. */
 static void
 sign_along_seams(run_state* s, size_t np, const int32_t* part_of, uint8_t* decided, double* pull)
 {
@@ -371,7 +371,7 @@ sign_along_seams(run_state* s, size_t np, const int32_t* part_of, uint8_t* decid
     for (size_t e = 0; e < s->bgraph.num_edges; ++e) {
       const dacpo_block_edge* be = &s->bgraph.edges[e];
       const int32_t qa = part_of[be->a], qb = part_of[be->b];
-      if (qa < 0 || qb < 0 || qa == qb || decided[qa] == decided[qb])
+      if (qa < 0 || qb < 0 || qa == qb || !decided[qa] == !decided[qb])
         continue;
       const int32_t q = decided[qa] ? qb : qa, r = decided[qa] ? qa : qb;
       pull[q] += stage5_evidence(s, be) * (double)s->part_sign[r];
@@ -410,13 +410,15 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
   for (size_t q = 0; r == DACPO_OK && q < np; ++q)
     if (size[q] > 0 && (anchor[comp[q]] < 0 || size[q] > size[anchor[comp[q]]]))
       anchor[comp[q]] = (int32_t)q;
-  for (size_t q = 0; r == DACPO_OK && q < np; ++q)
+  for (size_t q = 0; r == DACPO_OK && q < np; ++q) /* 2: the vote decides */
     decided[q] = size[q] == 0 || anchor[comp[q]] == (int32_t)q ||
-                 s->part_conf[q] >= DACPO_PART_MIN_MARGIN;
+                         s->part_conf[q] >= DACPO_PART_MIN_MARGIN
+                     ? 2
+                     : 0;
   if (r == DACPO_OK)
     sign_along_seams(s, np, part_of, decided, pull);
   for (size_t q = 0; r == DACPO_OK && q < np; ++q) {
-    if (size[q] == 0 || anchor[comp[q]] == (int32_t)q || s->part_conf[q] >= DACPO_PART_MIN_MARGIN)
+    if (decided[q] == 2)
       continue;
     const int32_t a = anchor[comp[q]];
     if (!decided[q]) /* no seam to a signed part */
