@@ -141,8 +141,8 @@ part_signs_facing(const double* xyz,
     const double* p = xyz + 3 * i;
     const double* q = nrm + 3 * i;
     const double d[3] = {v[0] - p[0], v[1] - p[1], v[2] - p[2]};
-    const double len =
-        sqrt((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
+    const double len = sqrt((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) *
+                            (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
     if (len > 0.0)
       vote[part[i]] += (q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / len;
   }
@@ -485,7 +485,8 @@ dacpo_part_closed_outward(const double* xyz,
         extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all)
       outward[q] = mc > 0.0 ? 1 : -1;
   }
-  slab_parts_outward(xyz, nrm, n, part, num_parts, centre, count, acc + 11 * num_parts, outward);
+  slab_parts_outward(
+      xyz, nrm, n, part, num_parts, centre, count, acc + 11 * num_parts, outward);
   free(acc);
   free(cells);
   return DACPO_OK;

@@ -11,10 +11,10 @@
  * {+1, -1} (multiply the part's normals by it; the largest part keeps +1) and
  * confidence[c] in [0, 1] (the vote margin: |mean cosine| between the part's
  * normals and the directions to the viewpoint; 1 for the largest part; 0 for
- * all others when no viewpoint explains the scene, then every sign stays +1). *score_out (may be NULL) gets the share of a
- * sample of the points that face the chosen viewpoint under their part's best
- * sign. The result does not depend on the run's seed.
- * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
+ * all others when no viewpoint explains the scene, then every sign stays +1).
+ * *score_out (may be NULL) gets the share of a sample of the points that face the
+ * chosen viewpoint under their part's best sign. The result does not depend on the
+ * run's seed. Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_part_signs(const double* xyz,
                  const double* nrm,

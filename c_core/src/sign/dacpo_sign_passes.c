@@ -364,7 +364,8 @@ label_parts(run_state* s, double weak, size_t* num_parts, dacpo_err* err)
  * marks them 1 (decided[] != 0: signed); part_of[b]: the part of block b (-1:
  * a block without points). pull: np scratch. */
 static void
-sign_along_seams(run_state* s, size_t np, const int32_t* part_of, uint8_t* decided, double* pull)
+sign_along_seams(
+    run_state* s, size_t np, const int32_t* part_of, uint8_t* decided, double* pull)
 {
   for (;;) {
     memset(pull, 0, np * sizeof(double));
@@ -378,7 +379,8 @@ sign_along_seams(run_state* s, size_t np, const int32_t* part_of, uint8_t* decid
     }
     size_t best = np;
     for (size_t q = 0; q < np; ++q)
-      if (!decided[q] && pull[q] != 0.0 && (best == np || fabs(pull[q]) > fabs(pull[best])))
+      if (!decided[q] && pull[q] != 0.0 &&
+          (best == np || fabs(pull[q]) > fabs(pull[best])))
         best = q;
     if (best == np)
       return;
@@ -397,7 +399,8 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
   int32_t* part_of = dacpo_malloc_array(nb ? nb : 1, sizeof(int32_t));
   uint8_t* decided = dacpo_calloc_array(np, sizeof(uint8_t));
   double* pull = dacpo_malloc_array(np, sizeof(double));
-  dacpo_status r = size && comp && anchor && part_of && decided && pull ? DACPO_OK : DACPO_OOM(err);
+  dacpo_status r =
+      size && comp && anchor && part_of && decided && pull ? DACPO_OK : DACPO_OOM(err);
   for (size_t b = 0; r == DACPO_OK && b < nb; ++b)
     part_of[b] = -1;
   for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
