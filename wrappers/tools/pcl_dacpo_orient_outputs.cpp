@@ -239,8 +239,10 @@ printStats(const Result& result)
   std::fprintf(stderr,
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
-               "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu surface_turned=%zu sensor_turned=%zu scan=%s single_view_fit=%.3f c=%g "
-               "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f sides=%g "
+               "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu "
+               "surface_turned=%zu sensor_turned=%zu scan=%s single_view_fit=%.3f c=%g "
+               "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f "
+               "copy_axes=%zu sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
                "ipsr_iterations_max=%zu restarts=%zu blocks_all_restarts=%zu "
@@ -268,6 +270,7 @@ printStats(const Result& result)
                s.layered_share,
                s.layered_copies,
                s.layered_doubled,
+               s.copy_scale_axes,
                s.dipole_sides_used,
                s.sign_flipped,
                s.sign_facing,

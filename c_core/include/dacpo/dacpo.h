@@ -318,6 +318,11 @@ typedef struct dacpo_stats {
                                    (>= 0.5: copies wider apart than the pair
                                    window, handled as layered_copies >= 0.04);
                                    0 when the test did not run */
+  size_t copy_scale_axes;     /**< estimated axes taken at a larger scale because
+                                   the floor shows copies (layered_copies or
+                                   layered_doubled fired): points whose PCA axis
+                                   turned by over 20 degrees at twice the
+                                   neighbours and held at a larger scale */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

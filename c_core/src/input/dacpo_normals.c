@@ -13,12 +13,16 @@
  * basis, so coincident or collinear neighbourhoods still yield a unit vector (its
  * direction is then arbitrary but deterministic), never NaN. Cost: O(n normal_k),
  * parallel over chunks of points. Failure modes: bad arguments (INVALID_ARGUMENT);
- * nothing else. */
+ * nothing else. Where the scan kind finds offset copies, the axes that turn
+ * with the scale are taken again at a larger one (dacpo_normals_copy_scale:
+ * its own kd-tree, 2, 4 and 8 x normal_k neighbours; OOM besides). */
 #include "dacpo_normals.h"
 
+#include "dacpo_kdtree.h"
 #include "dacpo_parallel.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 enum { NORMALS_CHUNK = 4096, JACOBI_MAX_SWEEPS = 50 };
@@ -73,12 +77,25 @@ dacpo_jacobi3(double a[3][3], double w[3], double v[3][3])
     w[i] = a[i][i];
 }
 
-/* The axis of least variance of the covariance c (unit; +z for a degenerate
- * one), the surface variation l0 / (l0 + l1 + l2) in *curv and, when elong is
- * not NULL, l1 / l2 (middle over largest eigenvalue). */
+/* Adds e e^T to the upper triangle (r <= s) of a covariance sum. */
+static void
+covariance_add(double c[3][3], const double e[3])
+{
+  for (int r = 0; r < 3; ++r)
+    for (int s = r; s < 3; ++s)
+      c[r][s] += e[r] * e[s];
+}
+
+/* The axis of least variance of the covariance c (its upper triangle filled,
+ * mirrored here; unit; +z for a degenerate one), the surface variation
+ * l0 / (l0 + l1 + l2) in *curv and, when elong is not NULL, l1 / l2 (middle
+ * over largest eigenvalue). */
 static void
 axis_of_covariance(double c[3][3], double nrm[3], double* curv, double* elong)
 {
+  c[1][0] = c[0][1];
+  c[2][0] = c[0][2];
+  c[2][1] = c[1][2];
   /* Scale to max |c_ij| = 1 so tiny or huge neighbourhoods neither underflow
    * nor overflow inside Jacobi; eigenvectors and l0/trace are scale-free. */
   double mx = 0.0;
@@ -161,15 +178,10 @@ pca_point(const dacpo_cloud* cloud,
         continue;
       p = (size_t)v;
     }
-    double e[3] = {xyz[3 * p] - m[0], xyz[3 * p + 1] - m[1], xyz[3 * p + 2] - m[2]};
-    for (int r = 0; r < 3; ++r)
-      for (int s = r; s < 3; ++s)
-        c[r][s] += e[r] * e[s];
+    const double e[3] = {
+        xyz[3 * p] - m[0], xyz[3 * p + 1] - m[1], xyz[3 * p + 2] - m[2]};
+    covariance_add(c, e);
   }
-  c[1][0] = c[0][1];
-  c[2][0] = c[0][2];
-  c[2][1] = c[1][2];
-
   axis_of_covariance(c, nrm, curv, elong);
 }
 
@@ -294,4 +306,125 @@ dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
   size_t tasks = (cloud->n + NORMALS_CHUNK - 1) / NORMALS_CHUNK;
   return dacpo_parallel_for(
       tasks, num_threads, normals_task, &job, NULL, DACPO_STAGE_NORMALS, err);
+}
+
+/* ---- axes of a scan of offset copies --------------------------------- */
+
+/* Two axes agree within this angle (a neighbourhood twice as large turns a
+ * flat layer's axis by a few degrees; copies' PCA noise turns it by tens). */
+#define STABLE_COS 0.9396926207859084 /* cos 20 degrees */
+
+/* PCA axis and surface variation of the first m points of a k-NN answer. */
+static void
+pca_rows(const double* xyz, const int32_t* idx, size_t m, double nrm[3], double* curv)
+{
+  double mean[3] = {0.0, 0.0, 0.0};
+  for (size_t j = 0; j < m; ++j)
+    for (int d = 0; d < 3; ++d)
+      mean[d] += xyz[3 * (size_t)idx[j] + d];
+  for (int d = 0; d < 3; ++d)
+    mean[d] /= (double)m;
+  double c[3][3] = {{0.0}};
+  for (size_t j = 0; j < m; ++j) {
+    const double* p = xyz + 3 * (size_t)idx[j];
+    const double e[3] = {p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]};
+    covariance_add(c, e);
+  }
+  axis_of_covariance(c, nrm, curv, NULL);
+}
+
+static int
+axes_agree(const double a[3], const double b[3])
+{
+  return fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) >= STABLE_COS;
+}
+
+typedef struct copy_axes_job {
+  const dacpo_cloud* cloud;
+  const dacpo_kdtree* tree;
+  size_t base_k; /* neighbours of the first larger scale (2 x normal_k) */
+  double* nrm;
+  float* curvature;
+  uint8_t* changed;
+} copy_axes_job;
+
+/* One point: the axis of the first of 2, 4 x normal_k neighbours that agrees
+ * with twice as many, if the given axis does not agree with the first. */
+static void
+copy_axis_point(const copy_axes_job* job, size_t i, int32_t* idx, double* d2)
+{
+  const double* xyz = job->cloud->xyz;
+  const size_t k2 = job->base_k, kmax = 4 * k2;
+  double a[3][3], curv[3];
+  size_t got = dacpo_kdtree_knn(job->tree, xyz + 3 * i, k2, idx, d2);
+  if (got < k2)
+    return;
+  pca_rows(xyz, idx, k2, a[0], &curv[0]);
+  if (axes_agree(job->nrm + 3 * i, a[0]))
+    return;
+  got = dacpo_kdtree_knn(job->tree, xyz + 3 * i, kmax, idx, d2);
+  if (got < kmax)
+    return;
+  pca_rows(xyz, idx, 2 * k2, a[1], &curv[1]);
+  pca_rows(xyz, idx, kmax, a[2], &curv[2]);
+  for (int s = 0; s < 2; ++s)
+    if (axes_agree(a[s], a[s + 1])) {
+      memcpy(job->nrm + 3 * i, a[s], sizeof(a[s]));
+      if (job->curvature)
+        job->curvature[i] = (float)curv[s];
+      job->changed[i] = 1;
+      return;
+    }
+}
+
+static dacpo_status
+copy_axes_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
+{
+  (void)thread_id;
+  const copy_axes_job* job = user;
+  const size_t n = job->cloud->n;
+  const size_t begin = task * NORMALS_CHUNK;
+  const size_t end = begin + NORMALS_CHUNK < n ? begin + NORMALS_CHUNK : n;
+  int32_t* idx = dacpo_malloc_array(4 * job->base_k, sizeof(int32_t));
+  double* d2 = dacpo_malloc_array(4 * job->base_k, sizeof(double));
+  dacpo_status st = idx && d2 ? DACPO_OK : DACPO_OOM(err);
+  for (size_t i = begin; st == DACPO_OK && i < end; ++i)
+    copy_axis_point(job, i, idx, d2);
+  free(idx);
+  free(d2);
+  return st;
+}
+
+dacpo_status
+dacpo_normals_copy_scale(const dacpo_cloud* cloud,
+                         size_t normal_k,
+                         unsigned num_threads,
+                         double* nrm,
+                         float* curvature,
+                         size_t* changed,
+                         dacpo_err* err)
+{
+  *changed = 0;
+  const size_t base_k = 2 * (normal_k > 0 ? normal_k : 1);
+  if (cloud->n < 4 * base_k)
+    return DACPO_OK;
+  dacpo_kdtree* tree = NULL;
+  DACPO_TRY(dacpo_kdtree_build_threads(cloud->xyz, cloud->n, num_threads, &tree, err));
+  uint8_t* flag = dacpo_calloc_array(cloud->n, sizeof(uint8_t));
+  dacpo_status st = flag ? DACPO_OK : DACPO_OOM(err);
+  if (st == DACPO_OK) {
+    copy_axes_job job = {cloud, tree, base_k, nrm, curvature, flag};
+    st = dacpo_parallel_for((cloud->n + NORMALS_CHUNK - 1) / NORMALS_CHUNK,
+                            num_threads,
+                            copy_axes_task,
+                            &job,
+                            NULL,
+                            DACPO_STAGE_NORMALS,
+                            err);
+  }
+  for (size_t i = 0; st == DACPO_OK && i < cloud->n; ++i)
+    *changed += flag[i];
+  free(flag);
+  dacpo_kdtree_free(tree);
+  return st;
 }

@@ -588,6 +588,46 @@ job_fail(dacpo_ctx* ctx, dacpo_status status, dacpo_err* err)
   return dacpo_ctx_fail(ctx, err);
 }
 
+/* Stage 0, a scan of many views (AUTO): whether its surfaces come as offset
+ * copies (fused with a registration error, dacpo_layered.c). The thin-part
+ * rules would read each pair of copies as a thin solid's two faces, so they
+ * are left out; copies are layers of one surface seen from one side, so c = 1
+ * as for a single view (Eq. 1's stacked vote reads them as opposite faces);
+ * and estimated axes are taken at a larger scale where the copies make PCA's
+ * noise (dacpo_normals_copy_scale). */
+static dacpo_status
+resolve_copies(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  DACPO_TRY(dacpo_layered_share(s->cloud.xyz,
+                                s->cloud.nrm,
+                                s->cloud.n,
+                                s->knn.idx,
+                                s->knn.sqd,
+                                s->knn.k,
+                                &st->layered_share,
+                                &st->layered_copies,
+                                &st->layered_doubled,
+                                err));
+  const int copies = st->layered_copies >= DACPO_LAYERED_COPIES ||
+                     st->layered_doubled >= DACPO_LAYERED_DOUBLED;
+  if (st->layered_share >= DACPO_LAYERED_SHARE || copies)
+    s->p.dipole_sides = 0.0;
+  if (!copies)
+    return DACPO_OK;
+  s->p.dipole_two_sheet = 0.0;
+  if (s->p.dipole_c < 0.0)
+    s->p.dipole_c = 1.0;
+  if (!s->p.estimate_normals)
+    return DACPO_OK;
+  return dacpo_normals_copy_scale(&s->cloud,
+                                  s->p.normal_k,
+                                  s->p.num_threads,
+                                  s->cloud.nrm,
+                                  s->curvature,
+                                  &st->copy_scale_axes,
+                                  err);
+}
+
 /* Stage 0: the scan kind (dacpo_view_kind.c) and the stage-2 setting it
  * implies. Resolved here, once, so that every work unit (in this process or
  * another) reads the same resolved parameters. */
@@ -598,6 +638,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->layered_share = 0.0;
   st->layered_copies = 0.0;
   st->layered_doubled = 0.0;
+  st->copy_scale_axes = 0;
   /* the sensor's fit and position: for the kind (AUTO) and, in one view, for
    * the last sign pass, which turns the points it sees squarely to face it */
   if (s->p.scan_kind != DACPO_SCAN_MULTI_VIEW)
@@ -613,33 +654,10 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   if (s->p.scan_kind == DACPO_SCAN_AUTO) {
     s->p.scan_kind = st->single_view_fit >= DACPO_SINGLE_VIEW_FIT ? DACPO_SCAN_SINGLE_VIEW
                                                                  : DACPO_SCAN_MULTI_VIEW;
-    /* Many views whose surfaces come as offset copies (fused with a
-     * registration error): the thin-part rules would read each pair of copies
-     * as a thin solid's two faces (dacpo_layered.c), so they are left out. A
-     * kind given by the caller is taken as it is. */
-    if (s->p.scan_kind == DACPO_SCAN_MULTI_VIEW) {
-      DACPO_TRY(dacpo_layered_share(s->cloud.xyz,
-                                    s->cloud.nrm,
-                                    s->cloud.n,
-                                    s->knn.idx,
-                                    s->knn.sqd,
-                                    s->knn.k,
-                                    &st->layered_share,
-                                    &st->layered_copies,
-                                    &st->layered_doubled,
-                                    err));
-      const int copies = st->layered_copies >= DACPO_LAYERED_COPIES ||
-                         st->layered_doubled >= DACPO_LAYERED_DOUBLED;
-      if (st->layered_share >= DACPO_LAYERED_SHARE || copies)
-        s->p.dipole_sides = 0.0;
-      /* copies are layers of one surface seen from one side: c = 1 as for a
-       * single view (Eq. 1's stacked vote reads them as opposite faces) */
-      if (copies) {
-        s->p.dipole_two_sheet = 0.0;
-        if (s->p.dipole_c < 0.0)
-          s->p.dipole_c = 1.0;
-      }
-    }
+    /* many views: are they offset copies? (a kind given by the caller is
+     * taken as it is) */
+    if (s->p.scan_kind == DACPO_SCAN_MULTI_VIEW)
+      DACPO_TRY(resolve_copies(s, st, err));
   }
   const int single = s->p.scan_kind == DACPO_SCAN_SINGLE_VIEW;
   s->sensor_known = single && st->single_view_fit >= DACPO_SENSOR_FIT &&
