@@ -349,32 +349,31 @@ typedef struct copy_axes_job {
 } copy_axes_job;
 
 /* One point: the axis of the first of 2, 4 x normal_k neighbours that agrees
- * with twice as many, if the given axis does not agree with the first. */
+ * with twice as many, if the given axis does not agree with the first. Each
+ * larger answer is asked for only when the smaller one did not settle it (the
+ * first m of k nearest are the m nearest: ties go to the lower index). */
 static void
 copy_axis_point(const copy_axes_job* job, size_t i, int32_t* idx, double* d2)
 {
   const double* xyz = job->cloud->xyz;
-  const size_t k2 = job->base_k, kmax = 4 * k2;
   double a[3][3], curv[3];
-  size_t got = dacpo_kdtree_knn(job->tree, xyz + 3 * i, k2, idx, d2);
-  if (got < k2)
-    return;
-  pca_rows(xyz, idx, k2, a[0], &curv[0]);
-  if (axes_agree(job->nrm + 3 * i, a[0]))
-    return;
-  got = dacpo_kdtree_knn(job->tree, xyz + 3 * i, kmax, idx, d2);
-  if (got < kmax)
-    return;
-  pca_rows(xyz, idx, 2 * k2, a[1], &curv[1]);
-  pca_rows(xyz, idx, kmax, a[2], &curv[2]);
-  for (int s = 0; s < 2; ++s)
-    if (axes_agree(a[s], a[s + 1])) {
-      memcpy(job->nrm + 3 * i, a[s], sizeof(a[s]));
+  const double* prev = job->nrm + 3 * i;
+  for (int s = 0; s < 3; ++s) {
+    const size_t k = job->base_k << s;
+    if (dacpo_kdtree_knn(job->tree, xyz + 3 * i, k, idx, d2) < k)
+      return;
+    pca_rows(xyz, idx, k, a[s], &curv[s]);
+    if (axes_agree(prev, a[s])) {
+      if (s == 0) /* the given axis holds */
+        return;
+      memcpy(job->nrm + 3 * i, a[s - 1], sizeof(a[s - 1]));
       if (job->curvature)
-        job->curvature[i] = (float)curv[s];
+        job->curvature[i] = (float)curv[s - 1];
       job->changed[i] = 1;
       return;
     }
+    prev = a[s];
+  }
 }
 
 static dacpo_status
