@@ -404,9 +404,10 @@ dacpo_normals_copy_scale(const dacpo_cloud* cloud,
                          dacpo_err* err)
 {
   *changed = 0;
-  const size_t base_k = 2 * (normal_k > 0 ? normal_k : 1);
-  if (cloud->n < 4 * base_k)
+  const size_t k = normal_k > 0 ? normal_k : 1;
+  if (k > cloud->n / 8) /* too few points for 8 x normal_k neighbours */
     return DACPO_OK;
+  const size_t base_k = 2 * k;
   dacpo_kdtree* tree = NULL;
   DACPO_TRY(dacpo_kdtree_build_threads(cloud->xyz, cloud->n, num_threads, &tree, err));
   uint8_t* flag = dacpo_calloc_array(cloud->n, sizeof(uint8_t));
