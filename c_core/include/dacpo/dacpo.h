@@ -315,7 +315,7 @@ typedef struct dacpo_stats {
   double layered_doubled;     /**< AUTO resolved to many views: on the same plane,
                                    the share of its surface points with a second
                                    parallel sheet anywhere within two band widths
-                                   (>= 0.5: copies wider apart than the pair
+                                   (>= 0.2: copies wider apart than the pair
                                    window, handled as layered_copies >= 0.04);
                                    0 when the test did not run */
   size_t copy_scale_axes;     /**< estimated axes taken at a larger scale because
