@@ -325,6 +325,25 @@ meanAxisError(const std::vector<double>& axes,
   return m ? sum / static_cast<double>(m) : -1.0;
 }
 
+// Mean |sin| against +z of the axes of floorAndWall's floor points within
+// 5 cm of the wall.
+double
+nearWallError(const std::vector<double>& p,
+              size_t floor_points,
+              const std::vector<double>& axes)
+{
+  const double up[3] = {0.0, 0.0, 1.0};
+  auto near_wall = [&](size_t i) { return p[3 * i] >= 0.6 - 0.05; };
+  return meanAxisError(axes, 0, floor_points, up, near_wall);
+}
+
+// floorAndWall's open floor: away from the wall and the edges.
+bool
+openFloor(const std::vector<double>& p, size_t i)
+{
+  return p[3 * i] > 0.1 && p[3 * i] < 0.3 && p[3 * i + 1] > 0.1 && p[3 * i + 1] < 0.5;
+}
+
 struct TwoNormals {
   std::vector<double> plain, adaptive;
 };
@@ -366,13 +385,12 @@ TEST(DacpoNormals, AdaptiveScaleKeepsAxesOffTheOtherFaceOfACorner)
   DoubleCloud dc(p);
   const TwoNormals t = plainAndAdaptive(dc, 24);
   const double up[3] = {0.0, 0.0, 1.0};
-  auto near_wall = [&](size_t i) { return p[3 * i] >= 0.6 - 0.05; };
-  const double plain = meanAxisError(t.plain, 0, floor_points, up, near_wall);
-  const double adaptive = meanAxisError(t.adaptive, 0, floor_points, up, near_wall);
+  const double plain = nearWallError(p, floor_points, t.plain);
+  const double adaptive = nearWallError(p, floor_points, t.adaptive);
   std::printf("corner: mean |sin| plain %.4f adaptive %.4f\n", plain, adaptive);
   EXPECT_LT(adaptive, 0.92 * plain);
   for (size_t i = 0; i < floor_points; ++i)
-    if (p[3 * i] > 0.1 && p[3 * i] < 0.3 && p[3 * i + 1] > 0.1 && p[3 * i + 1] < 0.5)
+    if (openFloor(p, i))
       ASSERT_LT(axisError(&t.adaptive[3 * i], up), 1e-9) << i;
 }
 
@@ -565,10 +583,8 @@ TEST(DacpoNormals, CopyScaleKeepsSteadyAxesAndTiltsASparseCorner)
   const std::vector<double> p = floorAndWall(&floor_points);
   DoubleCloud dc(p);
   const CopyScaled r = copyScaled(dc, 1);
-  const double up[3] = {0.0, 0.0, 1.0};
-  auto near_wall = [&](size_t i) { return p[3 * i] >= 0.6 - 0.05; };
-  const double before = meanAxisError(r.before, 0, floor_points, up, near_wall);
-  const double after = meanAxisError(r.after, 0, floor_points, up, near_wall);
+  const double before = nearWallError(p, floor_points, r.before);
+  const double after = nearWallError(p, floor_points, r.after);
   std::printf("corner: mean |sin| %.4f -> %.4f (%zu axes replaced)\n",
               before,
               after,
@@ -576,7 +592,7 @@ TEST(DacpoNormals, CopyScaleKeepsSteadyAxesAndTiltsASparseCorner)
   EXPECT_LT(r.changed, p.size() / 3 / 20);
   EXPECT_LT(after, before + 0.1);
   for (size_t i = 0; i < floor_points; ++i)
-    if (p[3 * i] > 0.1 && p[3 * i] < 0.3 && p[3 * i + 1] > 0.1 && p[3 * i + 1] < 0.5)
+    if (openFloor(p, i))
       ASSERT_EQ(std::memcmp(&r.after[3 * i], &r.before[3 * i], 3 * sizeof(double)), 0)
           << i;
 }
