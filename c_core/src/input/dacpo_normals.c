@@ -313,6 +313,9 @@ dacpo_normals_pca_scaled(const dacpo_cloud* cloud,
 /* Two axes agree within this angle (a neighbourhood twice as large turns a
  * flat layer's axis by a few degrees; copies' PCA noise turns it by tens). */
 #define STABLE_COS 0.9396926207859084 /* cos 20 degrees */
+/* Scales looked at: 2, 4, ..., 2^COPY_SCALES x normal_k neighbours (the
+ * wider apart the copies, the larger the scale where their axis holds). */
+#define COPY_SCALES 5
 
 /* PCA axis and surface variation of the first m points of a k-NN answer. */
 static void
@@ -348,17 +351,17 @@ typedef struct copy_axes_job {
   uint8_t* changed;
 } copy_axes_job;
 
-/* One point: the axis of the first of 2, 4 x normal_k neighbours that agrees
- * with twice as many, if the given axis does not agree with the first. Each
- * larger answer is asked for only when the smaller one did not settle it (the
+/* One point: the axis of the first of 2, 4, 8, 16 x normal_k neighbours
+ * that agrees with twice as many, if the given axis does not agree with the
+ * first. Each larger answer is asked for only when the smaller one did not settle it (the
  * first m of k nearest are the m nearest: ties go to the lower index). */
 static void
 copy_axis_point(const copy_axes_job* job, size_t i, int32_t* idx, double* d2)
 {
   const double* xyz = job->cloud->xyz;
-  double a[3][3], curv[3];
+  double a[COPY_SCALES][3], curv[COPY_SCALES];
   const double* prev = job->nrm + 3 * i;
-  for (int s = 0; s < 3; ++s) {
+  for (int s = 0; s < COPY_SCALES; ++s) {
     const size_t k = job->base_k << s;
     if (dacpo_kdtree_knn(job->tree, xyz + 3 * i, k, idx, d2) < k)
       return;
@@ -384,8 +387,9 @@ copy_axes_task(void* user, size_t task, unsigned thread_id, dacpo_err* err)
   const size_t n = job->cloud->n;
   const size_t begin = task * NORMALS_CHUNK;
   const size_t end = begin + NORMALS_CHUNK < n ? begin + NORMALS_CHUNK : n;
-  int32_t* idx = dacpo_malloc_array(4 * job->base_k, sizeof(int32_t));
-  double* d2 = dacpo_malloc_array(4 * job->base_k, sizeof(double));
+  const size_t most = job->base_k << (COPY_SCALES - 1);
+  int32_t* idx = dacpo_malloc_array(most, sizeof(int32_t));
+  double* d2 = dacpo_malloc_array(most, sizeof(double));
   dacpo_status st = idx && d2 ? DACPO_OK : DACPO_OOM(err);
   for (size_t i = begin; st == DACPO_OK && i < end; ++i)
     copy_axis_point(job, i, idx, d2);
@@ -405,7 +409,7 @@ dacpo_normals_copy_scale(const dacpo_cloud* cloud,
 {
   *changed = 0;
   const size_t k = normal_k > 0 ? normal_k : 1;
-  if (k > cloud->n / 8) /* too few points for 8 x normal_k neighbours */
+  if (k > cloud->n >> COPY_SCALES) /* too few points for the largest scale */
     return DACPO_OK;
   const size_t base_k = 2 * k;
   dacpo_kdtree* tree = NULL;

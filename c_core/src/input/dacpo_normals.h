@@ -41,13 +41,14 @@ dacpo_normals_width(size_t normal_k, int adaptive);
 /* Axes of a scan of offset copies (views fused with a registration error,
  * after the scan kind says so): where a point's axis turns by more than 20
  * degrees between its neighbourhood and 2 x normal_k neighbours, it takes the
- * axis of the first of 2 and 4 x normal_k neighbours that agrees within 20
- * degrees with twice as many (the copies make a neighbourhood about as thick
- * as it is wide at normal_k, so PCA's axis is noise there; a flat layer's
+ * axis of the first of 2, 4, 8 and 16 x normal_k neighbours that agrees
+ * within 20 degrees with twice as many (the copies make a neighbourhood about
+ * as thick as it is wide at normal_k, so PCA's axis is noise there; a flat layer's
  * axis holds as the neighbourhood grows). Where none agrees (corners, rims)
  * the axis stays. curvature (may be NULL) follows the chosen scale; *changed
  * gets the number of points whose axis was replaced. Builds its own kd-tree
- * (neighbours up to 8 x normal_k for the points that need them). */
+ * (neighbours up to 32 x normal_k for the points that need them); a cloud
+ * of fewer than 32 x normal_k points is left as it is. */
 dacpo_status
 dacpo_normals_copy_scale(const dacpo_cloud* cloud,
                          size_t normal_k,
