@@ -133,8 +133,8 @@ TEST(DacpoLayered, FusedRoomShowsCopiesAPlainOneDoesNot)
 // point of a generated room is lifted by `lift` spacings (its walls slide
 // along themselves); a thing resting on a floor covers only a part of it.
 // (Through the pipeline this room does not show it: each copy of the floor
-// holds half its points, a wall's band then holds more and does not span the
-// room, so nothing is measured; fz_lr_a_n20's lowest floor copy stays the
+// holds half its points, a wall's band then holds more, and the walls, slid
+// along themselves, show no copies; fz_lr_a_n20's lowest floor copy stays the
 // largest band.)
 TEST(DacpoLayered, CopiesWiderThanThePairWindowDoubleTheFloor)
 {
@@ -160,6 +160,39 @@ TEST(DacpoLayered, CopiesWiderThanThePairWindowDoubleTheFloor)
              pd);
       EXPECT_GE(doubled, DACPO_LAYERED_DOUBLED) << "seed " << seed << " lift " << lift;
       EXPECT_LT(pd, 0.25 * DACPO_LAYERED_DOUBLED) << "seed " << seed;
+    }
+  }
+}
+
+// Where the floor is hidden (cut out here: furniture, or frames that miss it)
+// the fullest band is a wall, which is lower than the room is deep; it lies
+// under the scene all the same (the room stands in front of it), so a fused
+// room's copies are read on the wall.
+TEST(DacpoLayered, CopiesAreReadOnAWallWhenTheFloorIsHidden)
+{
+  for (uint64_t seed = 1; seed <= 2; ++seed) {
+    for (unsigned views : {3u, 0u}) {
+      GeneratedScene room(roomParams(100000, views, seed));
+      ASSERT_TRUE(room.ok);
+      std::vector<float> xyz, nrm;
+      for (size_t i = 0; i < room.s.n; ++i) {
+        const float* p = room.s.xyz + 3 * i;
+        const float* g = room.s.normals + 3 * i;
+        if (p[2] < 0.1f && g[2] > 0.9f)
+          continue; // the floor
+        xyz.insert(xyz.end(), p, p + 3);
+        nrm.insert(nrm.end(), g, g + 3);
+      }
+      double copies = -1.0;
+      shareOf(xyz.data(), nrm.data(), xyz.size() / 3, &copies);
+      printf("seed %llu, %u views, no floor: copy rate %.3f\n",
+             (unsigned long long)seed,
+             views,
+             copies);
+      if (views)
+        EXPECT_GE(copies, DACPO_LAYERED_COPIES) << "seed " << seed;
+      else
+        EXPECT_LT(copies, 0.5 * DACPO_LAYERED_COPIES) << "seed " << seed;
     }
   }
 }

@@ -56,6 +56,12 @@
 #define LAYERED_PAIRS 3
 /* cells of the band's footprint along its longer side, at most */
 #define LAYERED_GRID 2048.0
+/* The band lies under the scene when this share of the points beyond its slab
+ * lies over it (values and margins: docs/DESIGN.md, "Copies or thin
+ * solids") ... */
+#define LAYERED_UNDER 0.5
+/* ... its box grown by this share of its smaller side. */
+#define LAYERED_UNDER_MARGIN 0.1
 
 static double
 dot3(const double* a, const double* b)
@@ -253,25 +259,34 @@ find_band(const double* xyz,
   return best_band;
 }
 
-/* 1 if the band [lo, lo + width] along dir spans the scene: the smaller of
- * its two extents in the plane is at least the depth of the scene along dir.
- * A floor spans the room above it; a strip of an object's curved wall with
- * the object on one side (a tube seen from outside) does not. */
+/* 1 if the band [lo, lo + width] along dir lies under the scene: at least
+ * LAYERED_UNDER of the points beyond the slab lie over the band's box in its
+ * plane, grown by LAYERED_UNDER_MARGIN of its smaller side (the walls stand
+ * on a floor's edge). A floor lies under the room above it, a wall under the
+ * room in front of it; a strip of an object's curved wall with the object on
+ * one side (a tube seen from outside) does not: the object reaches past it. */
 static int
-spans_scene(const double* xyz,
+under_scene(const double* xyz,
             const double* axes,
             size_t n,
             const double dir[3],
             double lo,
             double width)
 {
-  double e1[3], e2[3], box[4], depth = 0.0;
+  double e1[3], e2[3], box[4];
   band_box(xyz, axes, n, dir, lo, width, e1, e2, box);
+  const double grow = LAYERED_UNDER_MARGIN * fmin(box[1] - box[0], box[3] - box[2]);
+  size_t beyond = 0, over = 0;
   for (size_t i = 0; i < n; ++i) {
     const double y = dot3(dir, xyz + 3 * i);
-    depth = fmax(depth, fmax(lo - y, y - lo - width));
+    if (y >= lo - width && y <= lo + 2.0 * width)
+      continue;
+    beyond++;
+    const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
+    over += u >= box[0] - grow && u <= box[1] + grow && v >= box[2] - grow &&
+            v <= box[3] + grow;
   }
-  return fmin(box[1] - box[0], box[3] - box[2]) >= depth;
+  return beyond > 0 && (double)over >= LAYERED_UNDER * (double)beyond;
 }
 
 /* The slab around the band, [lo - width, lo + 2 width] along dir: its points
@@ -685,7 +700,7 @@ dacpo_layered_share(const double* xyz,
       minority_under_band(xyz, axes, n, dir, lo, width, below < above, &minority, err));
   if ((double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
     return DACPO_OK;
-  if (spans_scene(xyz, axes, n, dir, lo, width))
+  if (under_scene(xyz, axes, n, dir, lo, width))
     DACPO_TRY(copy_rates(xyz,
                          axes,
                          n,
