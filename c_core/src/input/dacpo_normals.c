@@ -353,8 +353,9 @@ typedef struct copy_axes_job {
 
 /* One point: the axis of the first of 2, 4, 8, 16 x normal_k neighbours
  * that agrees with twice as many, if the given axis does not agree with the
- * first. Each larger answer is asked for only when the smaller one did not settle it (the
- * first m of k nearest are the m nearest: ties go to the lower index). */
+ * first. Each larger answer is asked for only when the smaller one did not
+ * settle it (the first m of k nearest are the m nearest: ties go to the lower
+ * index). */
 static void
 copy_axis_point(const copy_axes_job* job, size_t i, int32_t* idx, double* d2)
 {

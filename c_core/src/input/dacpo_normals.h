@@ -43,8 +43,8 @@ dacpo_normals_width(size_t normal_k, int adaptive);
  * degrees between its neighbourhood and 2 x normal_k neighbours, it takes the
  * axis of the first of 2, 4, 8 and 16 x normal_k neighbours that agrees
  * within 20 degrees with twice as many (the copies make a neighbourhood about
- * as thick as it is wide at normal_k, so PCA's axis is noise there; a flat layer's
- * axis holds as the neighbourhood grows). Where none agrees (corners, rims)
+ * as thick as it is wide at normal_k, so PCA's axis is noise there; a flat
+ * layer's axis holds as the neighbourhood grows). Where none agrees (corners, rims)
  * the axis stays. curvature (may be NULL) follows the chosen scale; *changed
  * gets the number of points whose axis was replaced. Builds its own kd-tree
  * (neighbours up to 32 x normal_k for the points that need them); a cloud
