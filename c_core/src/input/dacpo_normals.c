@@ -15,7 +15,7 @@
  * parallel over chunks of points. Failure modes: bad arguments (INVALID_ARGUMENT);
  * nothing else. Where the scan kind finds offset copies, the axes that turn
  * with the scale are taken again at a larger one (dacpo_normals_copy_scale:
- * its own kd-tree, 2, 4 and 8 x normal_k neighbours; OOM besides). */
+ * its own kd-tree, 2 to 32 x normal_k neighbours; OOM besides). */
 #include "dacpo_normals.h"
 
 #include "dacpo_kdtree.h"
