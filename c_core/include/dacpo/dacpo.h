@@ -274,7 +274,9 @@ typedef struct dacpo_stats {
                                    its sensor (single_view_fit >= 0.7): distinct
                                    points turned to face it (those it sees within
                                    60 degrees of their normal), after every other
-                                   pass */
+                                   pass; 0 when most of those face away (the
+                                   sensor's mirror image) or, with parts signed
+                                   by their viewpoint, a fifth of them does */
   size_t cue_reconciled_blocks; /**< blocks turned after stage 6 where their side
                                      cue and the free space disagreed (groups of
                                      blocks against their cue whose anchors

@@ -755,7 +755,6 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
   return r;
 }
 
-
 /* One depth view: its sensor saw every point from the side the point's
  * normal must face, so where stage 0 found the sensor (a depth frame whose
  * density fits it by DACPO_SENSOR_FIT, dacpo_view_kind.c) a point it sees
@@ -766,8 +765,16 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
  * estimated axis and the estimated sensor decide less surely (docs/DESIGN.md,
  * "One view faces its sensor"). The density does not say on which side of the
  * surfaces the sensor stands: when most squarely seen points face away from
- * the position found, it is the mirror image and nothing turns. */
+ * the position found, it is the mirror image and nothing turns. Where the
+ * parts were signed by the viewpoint they imply (DISCONNECTED_VIEWPOINT) the
+ * pass mends stragglers, and when those facing away reach
+ * DACPO_SENSOR_MAX_AWAY of those facing, that viewpoint and the sensor
+ * disagree about where the scan was seen from: a scan of a few frames whose
+ * density fits one of them, the position found that frame's mirror image
+ * (docs/DESIGN.md, "A few frames that pass for one"); nothing turns then
+ * either. Parts left unrelated (SEPARATE) keep the pass's last word. */
 #define DACPO_SENSOR_SQUARE_COS 0.5
+#define DACPO_SENSOR_MAX_AWAY 0.25
 
 /* +1 / -1: point i's output normal (its axis, signed as the run signs it now)
  * faces the sensor squarely / faces away squarely; 0: seen near grazing. */
@@ -798,7 +805,10 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
     facing += side > 0;
     away += side < 0;
   }
-  if (away >= facing)
+  const double most = s->p.disconnected == DACPO_DISCONNECTED_VIEWPOINT
+                          ? DACPO_SENSOR_MAX_AWAY
+                          : 1.0; /* the mirror image only */
+  if ((double)away >= most * (double)facing)
     return DACPO_OK;
   if (!s->turned && !(s->turned = dacpo_calloc_array(n ? n : 1, sizeof(uint8_t))))
     return DACPO_OOM(err);
