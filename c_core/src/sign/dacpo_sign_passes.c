@@ -772,7 +772,8 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
  * disagree about where the scan was seen from: a scan of a few frames whose
  * density fits one of them, the position found that frame's mirror image
  * (docs/DESIGN.md, "A few frames that pass for one"); nothing turns then
- * either. Parts left unrelated (SEPARATE) keep the pass's last word. */
+ * either. Under the other policies (SEPARATE, BRIDGE) no vote signed the
+ * parts, and a reversed part is what the pass is there to mend. */
 #define DACPO_SENSOR_SQUARE_COS 0.5
 #define DACPO_SENSOR_MAX_AWAY 0.25
 
