@@ -78,13 +78,20 @@ in_band(const double dir[3], double lo, double width, const double* p, const dou
   return y >= lo && y <= lo + width && fabs(dot3(dir, a)) > LAYERED_COS;
 }
 
-/* 1 if point p (axis a) lies in the slab [lo - width, lo + 2 width] around
- * the band along dir and is parallel to it. */
+/* 1 if point p lies in the slab [lo - width, lo + 2 width] around the band
+ * [lo, lo + width] along dir. */
+static int
+within_slab(const double dir[3], double lo, double width, const double* p)
+{
+  const double y = dot3(dir, p);
+  return y >= lo - width && y <= lo + 2.0 * width;
+}
+
+/* 1 if point p (axis a) lies in the slab and is parallel to the band. */
 static int
 in_slab(const double dir[3], double lo, double width, const double* p, const double* a)
 {
-  const double y = dot3(dir, p);
-  return y >= lo - width && y <= lo + 2.0 * width && fabs(dot3(dir, a)) > LAYERED_COS;
+  return within_slab(dir, lo, width, p) && fabs(dot3(dir, a)) > LAYERED_COS;
 }
 
 /* The box of the band's points in its plane: frame e1, e2, box = u0, u1, v0,
@@ -278,8 +285,7 @@ under_scene(const double* xyz,
   const double grow = LAYERED_UNDER_MARGIN * fmin(box[1] - box[0], box[3] - box[2]);
   size_t beyond = 0, over = 0;
   for (size_t i = 0; i < n; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y >= lo - width && y <= lo + 2.0 * width)
+    if (within_slab(dir, lo, width, xyz + 3 * i))
       continue;
     beyond++;
     const double u = dot3(e1, xyz + 3 * i), v = dot3(e2, xyz + 3 * i);
@@ -595,8 +601,7 @@ side_share(const double* xyz,
       sxyz && saxes && pick && lxyz && laxes && lnb && side ? DACPO_OK : DACPO_OOM(err);
   size_t at = 0, seen = 0, taken = 0;
   for (size_t i = 0; i < n && st == DACPO_OK; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y < lo - width || y > lo + 2.0 * width)
+    if (!within_slab(dir, lo, width, xyz + 3 * i))
       continue;
     memcpy(sxyz + 3 * at, xyz + 3 * i, 3 * sizeof(double));
     memcpy(saxes + 3 * at, axes + 3 * i, 3 * sizeof(double));
