@@ -95,20 +95,19 @@ decode(const unsigned char* b, const Prop& p)
   }
 }
 
-// Returns x y z triples (3 * count floats).
-inline std::vector<float>
-read_xyz(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw std::runtime_error("cannot open " + path);
-  std::string line;
-  std::getline(in, line);
-  if (line.rfind("ply", 0) != 0)
-    throw std::runtime_error(path + ": not a PLY file");
+// The header's format and the "vertex" element's properties and count.
+struct Header {
   std::string format;
-  std::vector<Prop> props;
-  size_t count = 0;
+  std::vector<Prop> props; // of the "vertex" element
+  size_t count = 0;        // number of vertices
+};
+
+// Parses the PLY header (after the "ply" line) up to end_header.
+inline Header
+read_header(std::istream& in, const std::string& path)
+{
+  Header h;
+  std::string line;
   bool in_vertex = false, seen_vertex = false;
   while (std::getline(in, line)) {
     if (!line.empty() && line.back() == '\r')
@@ -117,14 +116,14 @@ read_xyz(const std::string& path)
     std::string word;
     ss >> word;
     if (word == "format") {
-      ss >> format;
+      ss >> h.format;
     }
     else if (word == "element") {
       std::string name;
       size_t n = 0;
       ss >> name >> n;
       if (name == "vertex") {
-        count = n;
+        h.count = n;
         in_vertex = true;
         seen_vertex = true;
       }
@@ -141,12 +140,79 @@ read_xyz(const std::string& path)
       if (type == "list")
         throw std::runtime_error(path + ": list property in 'vertex'");
       ss >> name;
-      props.push_back(make_prop(type, name));
+      h.props.push_back(make_prop(type, name));
     }
     else if (word == "end_header") {
       break;
     }
   }
+  return h;
+}
+
+// Reads count binary_little_endian vertices, keeping props idx[0..2] as x y z.
+inline void
+read_binary_xyz(std::istream& in,
+                const std::string& path,
+                const Header& h,
+                const int idx[3],
+                size_t stride,
+                std::vector<float>& xyz)
+{
+  const std::vector<Prop>& props = h.props;
+  const size_t count = h.count;
+  std::vector<size_t> offset(props.size());
+  size_t o = 0;
+  for (size_t i = 0; i < props.size(); ++i) {
+    offset[i] = o;
+    o += size_t(props[i].size);
+  }
+  std::vector<unsigned char> buf(stride * count);
+  in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
+  if (size_t(in.gcount()) != buf.size())
+    throw std::runtime_error(path + ": file is truncated");
+  for (size_t p = 0; p < count; ++p)
+    for (int c = 0; c < 3; ++c)
+      xyz[3 * p + c] = float(decode(&buf[p * stride + offset[idx[c]]], props[idx[c]]));
+}
+
+// Reads count ascii vertices, keeping props ix, iy, iz as x y z.
+inline void
+read_ascii_xyz(std::istream& in,
+               const std::string& path,
+               const Header& h,
+               int ix,
+               int iy,
+               int iz,
+               std::vector<float>& xyz)
+{
+  for (size_t p = 0; p < h.count; ++p) {
+    for (size_t i = 0; i < h.props.size(); ++i) {
+      double v;
+      if (!(in >> v))
+        throw std::runtime_error(path + ": file is truncated");
+      if (int(i) == ix)
+        xyz[3 * p] = float(v);
+      if (int(i) == iy)
+        xyz[3 * p + 1] = float(v);
+      if (int(i) == iz)
+        xyz[3 * p + 2] = float(v);
+    }
+  }
+}
+
+// Returns x y z triples (3 * count floats).
+inline std::vector<float>
+read_xyz(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw std::runtime_error("cannot open " + path);
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("ply", 0) != 0)
+    throw std::runtime_error(path + ": not a PLY file");
+  const Header h = read_header(in, path);
+  const std::vector<Prop>& props = h.props;
   int ix = -1, iy = -1, iz = -1;
   size_t stride = 0;
   for (size_t i = 0; i < props.size(); ++i) {
@@ -160,41 +226,16 @@ read_xyz(const std::string& path)
   }
   if (ix < 0 || iy < 0 || iz < 0)
     throw std::runtime_error(path + ": no x y z vertex properties");
-  std::vector<float> xyz(3 * count);
-  if (format == "binary_little_endian") {
-    std::vector<size_t> offset(props.size());
-    size_t o = 0;
-    for (size_t i = 0; i < props.size(); ++i) {
-      offset[i] = o;
-      o += size_t(props[i].size);
-    }
-    std::vector<unsigned char> buf(stride * count);
-    in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
-    if (size_t(in.gcount()) != buf.size())
-      throw std::runtime_error(path + ": file is truncated");
+  std::vector<float> xyz(3 * h.count);
+  if (h.format == "binary_little_endian") {
     const int idx[3] = {ix, iy, iz};
-    for (size_t p = 0; p < count; ++p)
-      for (int c = 0; c < 3; ++c)
-        xyz[3 * p + c] =
-            float(decode(&buf[p * stride + offset[idx[c]]], props[idx[c]]));
+    read_binary_xyz(in, path, h, idx, stride, xyz);
   }
-  else if (format == "ascii") {
-    for (size_t p = 0; p < count; ++p) {
-      for (size_t i = 0; i < props.size(); ++i) {
-        double v;
-        if (!(in >> v))
-          throw std::runtime_error(path + ": file is truncated");
-        if (int(i) == ix)
-          xyz[3 * p] = float(v);
-        if (int(i) == iy)
-          xyz[3 * p + 1] = float(v);
-        if (int(i) == iz)
-          xyz[3 * p + 2] = float(v);
-      }
-    }
+  else if (h.format == "ascii") {
+    read_ascii_xyz(in, path, h, ix, iy, iz, xyz);
   }
   else {
-    throw std::runtime_error(path + ": unsupported PLY format '" + format + "'");
+    throw std::runtime_error(path + ": unsupported PLY format '" + h.format + "'");
   }
   return xyz;
 }

@@ -90,6 +90,66 @@ set_point(
   b->gt[3 * i] = nx / l, b->gt[3 * i + 1] = ny / l, b->gt[3 * i + 2] = nz / l;
 }
 
+/* Sets point i on the thin board (kind 2) from the uniform draws u, v, w. */
+static void
+thin_board_point(block* b, size_t i, double u, double v, double w)
+{
+  /* areas: top, bottom 0.12 each; sides 0.008 (x faces 0.006) */
+  const double sx = 0.4, sy = 0.3, t = 0.02;
+  double a[6] = {sx * sy, sx * sy, sx * t, sx * t, sy * t, sy * t}, tot = 0;
+  for (int f = 0; f < 6; ++f)
+    tot += a[f];
+  double r = w * tot;
+  int f = 0;
+  while (f < 5 && r > a[f])
+    r -= a[f++];
+  double s1 = u - 0.5, s2 = v - 0.5;
+  if (f < 2)
+    set_point(b, i, sx * s1, sy * s2, f == 0 ? t / 2 : -t / 2, 0, 0, f == 0 ? 1 : -1);
+  else if (f < 4)
+    set_point(b, i, sx * s1, f == 2 ? sy / 2 : -sy / 2, t * s2, 0, f == 2 ? 1 : -1, 0);
+  else
+    set_point(b, i, f == 4 ? sx / 2 : -sx / 2, sy * s1, t * s2, f == 4 ? 1 : -1, 0, 0);
+}
+
+/* Sets point i on the room corner (kind 3) from the uniform draws u, v, w. */
+static void
+room_corner_point(block* b, size_t i, double u, double v, double w)
+{
+  /* floor [0,1.2]^2 z=0 (+z), wall x=0 (+x), wall y=0 (+y), height 1;
+   * box [0.5,0.8]^2 x [0,0.3] on the floor (top and 4 sides, outward) */
+  double a[7] = {1.44, 1.2, 1.2, 0.09, 0.09, 0.09, 0.09}, tot = 0;
+  for (int f = 0; f < 7; ++f)
+    tot += a[f];
+  double r = w * tot;
+  int f = 0;
+  while (f < 6 && r > a[f])
+    r -= a[f++];
+  double x = 1.2 * u, y = 1.2 * v;
+  if (f == 0) {
+    if (x > 0.5 && x < 0.8 && y > 0.5 && y < 0.8) { /* under the box: top instead */
+      set_point(b, i, x, y, 0.3, 0, 0, 1);
+      return;
+    }
+    set_point(b, i, x, y, 0, 0, 0, 1);
+  }
+  else if (f == 1)
+    set_point(b, i, 0, x, y / 1.2, 1, 0, 0);
+  else if (f == 2)
+    set_point(b, i, x, 0, y / 1.2, 0, 1, 0);
+  else {
+    double s = 0.5 + 0.3 * u, h = 0.3 * v;
+    if (f == 3)
+      set_point(b, i, 0.5, s, h, -1, 0, 0);
+    else if (f == 4)
+      set_point(b, i, 0.8, s, h, 1, 0, 0);
+    else if (f == 5)
+      set_point(b, i, s, 0.5, h, 0, -1, 0);
+    else
+      set_point(b, i, s, 0.8, h, 0, 1, 0);
+  }
+}
+
 /* kind: 0 wavy sheet, 1 half cylinder, 2 thin board (2 cm, 40 x 30 cm), 3 room
  * corner (floor + two walls + a box on the floor), 4 S-shaped sheet. */
 static int
@@ -114,63 +174,12 @@ generate(block* b, int kind, size_t n, dacpo_rng* rng)
       set_point(b, i, cos(t), 2 * v - 1, sin(t), cos(t), 0, sin(t));
       break;
     }
-    case 2: {
-      /* areas: top, bottom 0.12 each; sides 0.008 (x faces 0.006) */
-      const double sx = 0.4, sy = 0.3, t = 0.02;
-      double a[6] = {sx * sy, sx * sy, sx * t, sx * t, sy * t, sy * t}, tot = 0;
-      for (int f = 0; f < 6; ++f)
-        tot += a[f];
-      double r = w * tot;
-      int f = 0;
-      while (f < 5 && r > a[f])
-        r -= a[f++];
-      double s1 = u - 0.5, s2 = v - 0.5;
-      if (f < 2)
-        set_point(
-            b, i, sx * s1, sy * s2, f == 0 ? t / 2 : -t / 2, 0, 0, f == 0 ? 1 : -1);
-      else if (f < 4)
-        set_point(
-            b, i, sx * s1, f == 2 ? sy / 2 : -sy / 2, t * s2, 0, f == 2 ? 1 : -1, 0);
-      else
-        set_point(
-            b, i, f == 4 ? sx / 2 : -sx / 2, sy * s1, t * s2, f == 4 ? 1 : -1, 0, 0);
+    case 2:
+      thin_board_point(b, i, u, v, w);
       break;
-    }
-    case 3: {
-      /* floor [0,1.2]^2 z=0 (+z), wall x=0 (+x), wall y=0 (+y), height 1;
-       * box [0.5,0.8]^2 x [0,0.3] on the floor (top and 4 sides, outward) */
-      double a[7] = {1.44, 1.2, 1.2, 0.09, 0.09, 0.09, 0.09}, tot = 0;
-      for (int f = 0; f < 7; ++f)
-        tot += a[f];
-      double r = w * tot;
-      int f = 0;
-      while (f < 6 && r > a[f])
-        r -= a[f++];
-      double x = 1.2 * u, y = 1.2 * v;
-      if (f == 0) {
-        if (x > 0.5 && x < 0.8 && y > 0.5 && y < 0.8) { /* under the box: top instead */
-          set_point(b, i, x, y, 0.3, 0, 0, 1);
-          break;
-        }
-        set_point(b, i, x, y, 0, 0, 0, 1);
-      }
-      else if (f == 1)
-        set_point(b, i, 0, x, y / 1.2, 1, 0, 0);
-      else if (f == 2)
-        set_point(b, i, x, 0, y / 1.2, 0, 1, 0);
-      else {
-        double s = 0.5 + 0.3 * u, h = 0.3 * v;
-        if (f == 3)
-          set_point(b, i, 0.5, s, h, -1, 0, 0);
-        else if (f == 4)
-          set_point(b, i, 0.8, s, h, 1, 0, 0);
-        else if (f == 5)
-          set_point(b, i, s, 0.5, h, 0, -1, 0);
-        else
-          set_point(b, i, s, 0.8, h, 0, 1, 0);
-      }
+    case 3:
+      room_corner_point(b, i, u, v, w);
       break;
-    }
     default: {
       /* S: lower arc centre (0,0.5) r 0.5 from angle -90..90 (x>=0 side),
        * upper arc centre (0,1.5) 90..270; extruded along y in [-1,1] */
@@ -410,8 +419,20 @@ print_summary(const char* title, const summary* s)
          s->wrong_after / k);
 }
 
-int
-main(int argc, char** argv)
+/* The command-line options (see Usage above) and where the files start. */
+typedef struct options {
+  size_t n, per_scan;
+  int gen_kinds;
+  double noise;
+  double flip;
+  dacpo_ipsr_params prm;
+  int first_file;
+} options;
+
+/* Parses the command-line options (and -dump into g_dump); files start at
+ * first_file. */
+static void
+parse_options(int argc, char** argv, options* o)
 {
   size_t n = 2500, per_scan = 4;
   int gen_kinds = 5;
@@ -454,6 +475,67 @@ main(int argc, char** argv)
       break;
     }
   }
+  o->n = n;
+  o->per_scan = per_scan;
+  o->gen_kinds = gen_kinds;
+  o->noise = noise;
+  o->flip = flip;
+  o->prm = prm;
+  o->first_file = first_file;
+}
+
+/* Runs per_scan blocks cut from the scan at path (skipped without normals or
+ * with fewer than n points), adding them to s. */
+static void
+run_scan(const char* path, const options* o, dacpo_rng* rng, summary* s)
+{
+  const size_t n = o->n;
+  dacpo_ply_cloud c;
+  char msg[256];
+  if (dacpo_ply_read(path, &c, msg, sizeof(msg)) != DACPO_PLY_OK || !c.normals ||
+      c.n < n) {
+    printf("%s: skipped (%s)\n", path, c.normals ? msg : "no normals or too small");
+    dacpo_ply_cloud_free(&c);
+    return;
+  }
+  double* pts = malloc(3 * c.n * sizeof(double));
+  dacpo_kdtree* tree = NULL;
+  dacpo_err err = {0};
+  if (pts) {
+    for (size_t i = 0; i < 3 * c.n; ++i)
+      pts[i] = c.xyz[i];
+    /* blocks depend on the file only, not on the options before it */
+    dacpo_rng_seed(rng, 7, (uint64_t)c.n);
+    if (dacpo_kdtree_build(pts, c.n, &tree, &err) == DACPO_OK) {
+      const char* base = strrchr(path, '/');
+      base = base ? base + 1 : path;
+      for (size_t r = 0; r < o->per_scan; ++r) {
+        block b = {{0}, 0, NULL, NULL};
+        char name[64];
+        snprintf(name, sizeof(name), "%.24s#%zu", base, r);
+        if (cut_block(&b, name, &c, tree, pts, n, rng)) {
+          if (o->noise > 0.0)
+            add_noise(&b, o->noise, rng);
+          run_block(&b, &o->prm, o->flip, rng, s);
+        }
+        free(b.p), free(b.gt);
+      }
+    }
+    dacpo_kdtree_free(tree);
+  }
+  free(pts);
+  dacpo_ply_cloud_free(&c);
+}
+
+int
+main(int argc, char** argv)
+{
+  options o;
+  parse_options(argc, argv, &o);
+  const size_t n = o.n;
+  const int gen_kinds = o.gen_kinds;
+  const double noise = o.noise, flip = o.flip;
+  const dacpo_ipsr_params prm = o.prm;
   printf("bench_ipsr: n %zu, flipped %.0f%%, noise %g spacings, cell_per_spacing %g, "
          "point_weight %g, max_resolution %zu, band %zu, tolerance %g\n",
          n,
@@ -478,44 +560,8 @@ main(int argc, char** argv)
       free(b.p), free(b.gt);
     }
   print_summary("generated", &gen);
-  for (int f = first_file; f < argc; ++f) {
-    dacpo_ply_cloud c;
-    char msg[256];
-    if (dacpo_ply_read(argv[f], &c, msg, sizeof(msg)) != DACPO_PLY_OK || !c.normals ||
-        c.n < n) {
-      printf(
-          "%s: skipped (%s)\n", argv[f], c.normals ? msg : "no normals or too small");
-      dacpo_ply_cloud_free(&c);
-      continue;
-    }
-    double* pts = malloc(3 * c.n * sizeof(double));
-    dacpo_kdtree* tree = NULL;
-    dacpo_err err = {0};
-    if (pts) {
-      for (size_t i = 0; i < 3 * c.n; ++i)
-        pts[i] = c.xyz[i];
-      /* blocks depend on the file only, not on the options before it */
-      dacpo_rng_seed(&rng, 7, (uint64_t)c.n);
-      if (dacpo_kdtree_build(pts, c.n, &tree, &err) == DACPO_OK) {
-        const char* base = strrchr(argv[f], '/');
-        base = base ? base + 1 : argv[f];
-        for (size_t r = 0; r < per_scan; ++r) {
-          block b = {{0}, 0, NULL, NULL};
-          char name[64];
-          snprintf(name, sizeof(name), "%.24s#%zu", base, r);
-          if (cut_block(&b, name, &c, tree, pts, n, &rng)) {
-            if (noise > 0.0)
-              add_noise(&b, noise, &rng);
-            run_block(&b, &prm, flip, &rng, &real);
-          }
-          free(b.p), free(b.gt);
-        }
-      }
-      dacpo_kdtree_free(tree);
-    }
-    free(pts);
-    dacpo_ply_cloud_free(&c);
-  }
+  for (int f = o.first_file; f < argc; ++f)
+    run_scan(argv[f], &o, &rng, &real);
   print_summary("real-scan blocks", &real);
   return 0;
 }

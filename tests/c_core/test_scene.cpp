@@ -749,27 +749,15 @@ TEST(DacpoPly, ReadsExtraPropertiesElementsAndFormats)
   std::remove(path.c_str());
 }
 
-TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
+namespace {
+
+// The valid PLY file good cut at several places (header and data) is rejected.
+void
+ExpectTruncatedFilesRejected(const std::string& path,
+                             const std::vector<unsigned char>& good,
+                             char (&err)[256],
+                             dacpo_ply_cloud& c)
 {
-  char err[256];
-  dacpo_ply_cloud c;
-  const std::string path = TempPath("bad.ply");
-
-  // Missing file.
-  EXPECT_EQ(dacpo_ply_read((path + ".missing").c_str(), &c, err, sizeof(err)),
-            DACPO_PLY_ERR_IO);
-  EXPECT_GT(std::strlen(err), 0u);
-  EXPECT_EQ(dacpo_ply_read(nullptr, &c, err, sizeof(err)), DACPO_PLY_ERR_ARGUMENT);
-  EXPECT_EQ(dacpo_ply_read(path.c_str(), nullptr, err, sizeof(err)),
-            DACPO_PLY_ERR_ARGUMENT);
-
-  // Truncated: a valid file cut at several places (header and data).
-  Scene sc(DACPO_SCENE_PLANE, 500, 1);
-  ASSERT_EQ(
-      dacpo_ply_write(
-          path.c_str(), sc.s.xyz, sc.s.normals, sc.s.n, nullptr, err, sizeof(err)),
-      DACPO_PLY_OK);
-  const std::vector<unsigned char> good = ReadBytes(path);
   for (size_t cut : {size_t(0),
                      size_t(2),
                      size_t(40),
@@ -787,8 +775,12 @@ TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
   WriteBytes(path, good.data(), good.size() - 1);
   EXPECT_EQ(dacpo_ply_read(path.c_str(), &c, err, sizeof(err)), DACPO_PLY_ERR_FORMAT);
   EXPECT_NE(std::string(err).find("truncated"), std::string::npos) << err;
+}
 
-  // Garbage bytes (fixed seed), and garbage after a valid first line.
+// Garbage bytes (fixed seed), and garbage after a valid first line, are rejected.
+void
+ExpectGarbageRejected(const std::string& path, char (&err)[256], dacpo_ply_cloud& c)
+{
   std::vector<unsigned char> junk(5000);
   uint64_t x = 12345;
   for (auto& b : junk) {
@@ -801,8 +793,12 @@ TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
   std::memcpy(junk2.data(), "ply\n", 4);
   WriteBytes(path, junk2.data(), junk2.size());
   EXPECT_EQ(dacpo_ply_read(path.c_str(), &c, err, sizeof(err)), DACPO_PLY_ERR_FORMAT);
+}
 
-  // Headers that lie or are malformed.
+// Headers that lie or are malformed, and a huge header line, are rejected.
+void
+ExpectBadHeadersRejected(const std::string& path, char (&err)[256], dacpo_ply_cloud& c)
+{
   const char* bad_headers[] = {
       // absurd count: rejected before allocating
       "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n"
@@ -842,6 +838,38 @@ TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
   std::string longline = "ply\ncomment " + std::string(5000, 'a') + "\n";
   WriteBytes(path, longline.data(), longline.size());
   EXPECT_EQ(dacpo_ply_read(path.c_str(), &c, err, sizeof(err)), DACPO_PLY_ERR_FORMAT);
+}
+
+} // namespace
+
+TEST(DacpoPly, BadFilesGiveErrorsNotCrashes)
+{
+  char err[256];
+  dacpo_ply_cloud c;
+  const std::string path = TempPath("bad.ply");
+
+  // Missing file.
+  EXPECT_EQ(dacpo_ply_read((path + ".missing").c_str(), &c, err, sizeof(err)),
+            DACPO_PLY_ERR_IO);
+  EXPECT_GT(std::strlen(err), 0u);
+  EXPECT_EQ(dacpo_ply_read(nullptr, &c, err, sizeof(err)), DACPO_PLY_ERR_ARGUMENT);
+  EXPECT_EQ(dacpo_ply_read(path.c_str(), nullptr, err, sizeof(err)),
+            DACPO_PLY_ERR_ARGUMENT);
+
+  // Truncated: a valid file cut at several places (header and data).
+  Scene sc(DACPO_SCENE_PLANE, 500, 1);
+  ASSERT_EQ(
+      dacpo_ply_write(
+          path.c_str(), sc.s.xyz, sc.s.normals, sc.s.n, nullptr, err, sizeof(err)),
+      DACPO_PLY_OK);
+  const std::vector<unsigned char> good = ReadBytes(path);
+  ExpectTruncatedFilesRejected(path, good, err, c);
+
+  // Garbage bytes (fixed seed), and garbage after a valid first line.
+  ExpectGarbageRejected(path, err, c);
+
+  // Headers that lie or are malformed.
+  ExpectBadHeadersRejected(path, err, c);
 
   // Writing to a directory that does not exist.
   EXPECT_EQ(dacpo_ply_write("/nonexistent_dir_dacpo/x.ply",

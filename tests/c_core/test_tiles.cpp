@@ -193,42 +193,41 @@ TEST(DacpoTiles, JoinFollowsTheStrongestEvidence)
   EXPECT_EQ(std::vector<int>(flip, flip + 5), (std::vector<int>{1, 1, 0, 1, 0}));
 }
 
-// A room oriented tile by tile (own + halo points in input order, each by
-// dacpo_orient), every other tile's answer negated before the join, as a tile
-// with its own global sign may come out: the join must undo exactly those.
-TEST(DacpoTiles, RoomTilesJoinToOneSign)
+using HaloNormals = std::vector<std::map<size_t, std::vector<float>>>;
+
+// Each point's own tile into owner, and each tile's own and halo points into
+// members (unsorted).
+void
+tileMembers(const dacpo_tile_plan* plan,
+            const GeneratedScene& sc,
+            std::vector<int32_t>& owner,
+            std::vector<std::vector<size_t>>& members)
 {
-  GeneratedScene sc(DACPO_SCENE_ROOM, 40000, 5);
-  ASSERT_TRUE(sc.ok);
   const size_t n = sc.s.n;
-  std::vector<float> sample;
-  for (size_t i = 0; i < n; i += 4)
-    sample.insert(sample.end(), sc.s.xyz + 3 * i, sc.s.xyz + 3 * i + 3);
-  auto plan = makePlan(sample, n, 14000, 0.0);
-  ASSERT_TRUE(plan);
-  const size_t T = dacpo_tile_plan_count(plan.get());
-  ASSERT_GE(T, 4u);
-  std::vector<std::vector<size_t>> members(T);
-  std::vector<int32_t> owner(n);
   for (size_t i = 0; i < n; ++i) {
     int32_t halo[32];
     size_t nh = 0;
-    owner[i] = dacpo_tile_locate(plan.get(), sc.s.xyz + 3 * i, halo, 32, &nh);
+    owner[i] = dacpo_tile_locate(plan, sc.s.xyz + 3 * i, halo, 32, &nh);
     ASSERT_LE(nh, 32u);
     members[owner[i]].push_back(i);
     for (size_t h = 0; h < nh; ++h)
       members[halo[h]].push_back(i);
   }
-  dacpo_params p;
-  dacpo_params_init(&p);
-  p.estimate_normals = 1;
-  p.num_threads = 2;
-  p.seed = 1;
-  dacpo_ctx* ctx = nullptr;
-  ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  std::vector<float> normal(3 * n, 0.0f);
-  std::vector<std::map<size_t, std::vector<float>>> halo_normal(T);
-  std::vector<uint64_t> own_points(T, 0);
+}
+
+// Orients each tile's members in input order, every odd tile's answer negated:
+// own points into normal (counted in own_points), halo points into halo_normal.
+void
+orientTiles(dacpo_ctx* ctx,
+            const dacpo_params& p,
+            const GeneratedScene& sc,
+            std::vector<std::vector<size_t>>& members,
+            const std::vector<int32_t>& owner,
+            std::vector<float>& normal,
+            HaloNormals& halo_normal,
+            std::vector<uint64_t>& own_points)
+{
+  const size_t T = members.size();
   for (size_t t = 0; t < T; ++t) {
     std::vector<size_t>& m = members[t];
     std::sort(m.begin(), m.end());
@@ -249,7 +248,16 @@ TEST(DacpoTiles, RoomTilesJoinToOneSign)
         halo_normal[t][m[j]] = v;
     }
   }
-  dacpo_ctx_free(ctx);
+}
+
+// The join's evidence: for each tile and each tile owning one of its halo
+// points, the agreement of the two answers there, summed.
+std::vector<dacpo_tile_overlap>
+overlapEvidence(size_t T,
+                const std::vector<int32_t>& owner,
+                const std::vector<float>& normal,
+                const HaloNormals& halo_normal)
+{
   std::map<std::pair<uint32_t, uint32_t>, dacpo_tile_overlap> ev;
   for (size_t t = 0; t < T; ++t)
     for (const auto& [i, v] : halo_normal[t]) {
@@ -263,6 +271,42 @@ TEST(DacpoTiles, RoomTilesJoinToOneSign)
   std::vector<dacpo_tile_overlap> list;
   for (const auto& kv : ev)
     list.push_back(kv.second);
+  return list;
+}
+
+// A room oriented tile by tile (own + halo points in input order, each by
+// dacpo_orient), every other tile's answer negated before the join, as a tile
+// with its own global sign may come out: the join must undo exactly those.
+TEST(DacpoTiles, RoomTilesJoinToOneSign)
+{
+  GeneratedScene sc(DACPO_SCENE_ROOM, 40000, 5);
+  ASSERT_TRUE(sc.ok);
+  const size_t n = sc.s.n;
+  std::vector<float> sample;
+  for (size_t i = 0; i < n; i += 4)
+    sample.insert(sample.end(), sc.s.xyz + 3 * i, sc.s.xyz + 3 * i + 3);
+  auto plan = makePlan(sample, n, 14000, 0.0);
+  ASSERT_TRUE(plan);
+  const size_t T = dacpo_tile_plan_count(plan.get());
+  ASSERT_GE(T, 4u);
+  std::vector<std::vector<size_t>> members(T);
+  std::vector<int32_t> owner(n);
+  ASSERT_NO_FATAL_FAILURE(tileMembers(plan.get(), sc, owner, members));
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.estimate_normals = 1;
+  p.num_threads = 2;
+  p.seed = 1;
+  dacpo_ctx* ctx = nullptr;
+  ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+  std::vector<float> normal(3 * n, 0.0f);
+  std::vector<std::map<size_t, std::vector<float>>> halo_normal(T);
+  std::vector<uint64_t> own_points(T, 0);
+  ASSERT_NO_FATAL_FAILURE(
+      orientTiles(ctx, p, sc, members, owner, normal, halo_normal, own_points));
+  dacpo_ctx_free(ctx);
+  const std::vector<dacpo_tile_overlap> list =
+      overlapEvidence(T, owner, normal, halo_normal);
   std::vector<uint8_t> flip(T);
   ASSERT_EQ(dacpo_tile_join(T, list.data(), list.size(), own_points.data(), flip.data(), nullptr, 0),
             DACPO_OK);

@@ -657,12 +657,13 @@ TEST(DacpoVcr, ConcurrentCallsGiveTheSameAnswer)
   }
 }
 
-TEST(DacpoVcr, RoomBlocksWithRandomFlipsAreRealigned)
+namespace {
+
+// The open room (floor + 4 walls, normals towards the inside) of W x D x H cut
+// into 12 blocks, gridded at cell.
+std::vector<Mesh>
+roomBlocks(double W, double D, double H, double cell)
 {
-  // An open room (floor + 4 walls, normals towards the inside) cut into 12
-  // blocks; blocks are flipped at random; the flips maximizing the sum of
-  // omega (paper Eq. 7-8, brute force over 2^11) must undo them.
-  const double W = 4, D = 3, H = 2.5, cell = 0.1;
   std::vector<Mesh> blocks;
   auto add = [&](const Surf& f, double lu, double lw) {
     blocks.push_back(grid((int)std::lround(lu / cell), (int)std::lround(lw / cell), f));
@@ -699,6 +700,72 @@ TEST(DacpoVcr, RoomBlocksWithRandomFlipsAreRealigned)
         H,
         D / 2); // x=W, -x
   }
+  return blocks;
+}
+
+// An edge between blocks i and j with its omega for the same and the differing
+// orientation.
+struct BlockEdge {
+  size_t i, j;
+  double same, differ;
+};
+
+// The edges between blocks sharing a vertex position, with their omega.
+std::vector<BlockEdge>
+adjacentBlockEdges(std::vector<Mesh>& blocks)
+{
+  const size_t nb = blocks.size();
+  std::vector<BlockEdge> edges;
+  for (size_t i = 0; i < nb; ++i)
+    for (size_t j = i + 1; j < nb; ++j) {
+      bool adj = false;
+      for (size_t p = 0; p < blocks[i].v.size() && !adj; p += 3)
+        for (size_t q = 0; q < blocks[j].v.size() && !adj; q += 3) {
+          double dx = blocks[i].v[p] - blocks[j].v[q],
+                 dy = blocks[i].v[p + 1] - blocks[j].v[q + 1],
+                 dz = blocks[i].v[p + 2] - blocks[j].v[q + 2];
+          adj = dx * dx + dy * dy + dz * dz < 1e-12;
+        }
+      if (!adj)
+        continue;
+      Result r = edge(blocks[i], blocks[j]);
+      BlockEdge e{i, j, 0, 0};
+      dacpo_edge_omega(r.alpha, r.alpha_bar, 0.0, &e.same, &e.differ);
+      edges.push_back(e);
+    }
+  return edges;
+}
+
+// The flips of blocks 0 .. nb-2 (block nb-1 fixed) maximizing the sum of omega
+// over edges, by brute force; the first maximum in mask order.
+unsigned
+bestFlipMask(size_t nb, const std::vector<BlockEdge>& edges)
+{
+  double best = -1;
+  unsigned best_mask = 0;
+  for (unsigned mask = 0; mask < (1u << (nb - 1)); ++mask) { // block nb-1 fixed
+    double s = 0;
+    for (const BlockEdge& e : edges) {
+      int oi = (mask >> e.i) & 1, oj = (mask >> e.j) & 1;
+      s += oi == oj ? e.same : e.differ;
+    }
+    if (s > best) {
+      best = s;
+      best_mask = mask;
+    }
+  }
+  return best_mask;
+}
+
+} // namespace
+
+TEST(DacpoVcr, RoomBlocksWithRandomFlipsAreRealigned)
+{
+  // An open room (floor + 4 walls, normals towards the inside) cut into 12
+  // blocks; blocks are flipped at random; the flips maximizing the sum of
+  // omega (paper Eq. 7-8, brute force over 2^11) must undo them.
+  const double W = 4, D = 3, H = 2.5, cell = 0.1;
+  std::vector<Mesh> blocks = roomBlocks(W, D, H, cell);
   const size_t nb = blocks.size();
   double inside[3] = {W / 2, D / 2, H / 2};
   for (auto& m : blocks)
@@ -713,42 +780,9 @@ TEST(DacpoVcr, RoomBlocksWithRandomFlipsAreRealigned)
   for (auto& m : blocks)
     m = posed(m);
   // adjacency: blocks sharing a vertex position
-  struct E {
-    size_t i, j;
-    double same, differ;
-  };
-  std::vector<E> edges;
-  for (size_t i = 0; i < nb; ++i)
-    for (size_t j = i + 1; j < nb; ++j) {
-      bool adj = false;
-      for (size_t p = 0; p < blocks[i].v.size() && !adj; p += 3)
-        for (size_t q = 0; q < blocks[j].v.size() && !adj; q += 3) {
-          double dx = blocks[i].v[p] - blocks[j].v[q],
-                 dy = blocks[i].v[p + 1] - blocks[j].v[q + 1],
-                 dz = blocks[i].v[p + 2] - blocks[j].v[q + 2];
-          adj = dx * dx + dy * dy + dz * dz < 1e-12;
-        }
-      if (!adj)
-        continue;
-      Result r = edge(blocks[i], blocks[j]);
-      E e{i, j, 0, 0};
-      dacpo_edge_omega(r.alpha, r.alpha_bar, 0.0, &e.same, &e.differ);
-      edges.push_back(e);
-    }
+  const std::vector<BlockEdge> edges = adjacentBlockEdges(blocks);
   EXPECT_GE(edges.size(), 16u);
-  double best = -1;
-  unsigned best_mask = 0;
-  for (unsigned mask = 0; mask < (1u << (nb - 1)); ++mask) { // block nb-1 fixed
-    double s = 0;
-    for (const E& e : edges) {
-      int oi = (mask >> e.i) & 1, oj = (mask >> e.j) & 1;
-      s += oi == oj ? e.same : e.differ;
-    }
-    if (s > best) {
-      best = s;
-      best_mask = mask;
-    }
-  }
+  const unsigned best_mask = bestFlipMask(nb, edges);
   for (size_t i = 0; i < nb; ++i) {
     int oi = i + 1 < nb ? (int)((best_mask >> i) & 1) : 0;
     // undoing: o_i XOR truth_i must be the same for every block
