@@ -267,7 +267,9 @@ typedef struct dacpo_stats {
   size_t cue_anchored_blocks; /**< blocks tied to the side cue's sign in stage 5
                                    (dacpo_params.cue_anchor) */
   size_t parts_cue_signed;    /**< parts (not the largest) whose sign the cue
-                                   turned after the viewpoint vote and stage 6 */
+                                   turned after the viewpoint vote and stage 6
+                                   (only parts whose cue points are at least a
+                                   quarter of their points) */
   size_t surface_vote_turned; /**< distinct points the surface vote turned over
                                    (dacpo_params.surface_vote) */
   size_t sensor_turned;       /**< FREE_SPACE, one depth view whose density places

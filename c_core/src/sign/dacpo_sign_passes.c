@@ -453,14 +453,17 @@ keep_weak_evidence(run_state* s, size_t np, dacpo_err* err)
  * into one part per sheet by weak block edges), the others follow the cue
  * the way the largest part does, so the parts stay consistent with each
  * other (two sheets one spacing apart, blocks of 625 points: 49.7 -> 0 %) -
- * but only where those cue points are at least DACPO_CUE_REFERENCE_MIN_SHARE
- * of the largest part: in a room its shell has free space to go by, and a
- * few of its blocks against their cue (a bookshelf against a wall: 3,347 of
- * 89,481 points, 52 % net against) had turned a table and a partition in
- * other parts inside out (generated room, seed 12, run seed 1: 11.28 ->
- * 5.00 %; both shared suites unchanged). */
+ * but only where those cue points are at least DACPO_CUE_MIN_SHARE of the
+ * largest part: in a room its shell has free space to go by, and a few of its
+ * blocks against their cue (a bookshelf against a wall: 3,347 of 89,481
+ * points, 52 % net against) had turned a table and a partition in other
+ * parts inside out (generated room, seed 12, run seed 1: 11.28 -> 5.00 %).
+ * The same share bounds the parts that follow: a few cue points do not turn
+ * a part the vote signed (where frames lie a few millimetres apart the cue
+ * reads a wall's copies as faces; docs/DESIGN.md, "The other parts follow
+ * the cue only where it covers a quarter of them too"). */
 #define DACPO_CUE_REFERENCE_MARGIN 0.5
-#define DACPO_CUE_REFERENCE_MIN_SHARE 0.25
+#define DACPO_CUE_MIN_SHARE 0.25
 
 static dacpo_status
 parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
@@ -488,11 +491,11 @@ parts_follow_the_cue(run_state* s, size_t np, size_t* turned, dacpo_err* err)
   const double big_agrees = (double)s->part_sign[big] * s->global_sign * vote[big];
   const double reference =
       big_agrees < -DACPO_CUE_REFERENCE_MARGIN * weight[big] &&
-              weight[big] >= DACPO_CUE_REFERENCE_MIN_SHARE * (double)size[big]
+              weight[big] >= DACPO_CUE_MIN_SHARE * (double)size[big]
           ? -1.0
           : 1.0;
   for (size_t q = 0; q < np; ++q)
-    if (q != big &&
+    if (q != big && weight[q] >= DACPO_CUE_MIN_SHARE * (double)size[q] &&
         (double)s->part_sign[q] * s->global_sign * vote[q] * reference < 0.0) {
       s->part_sign[q] = (int8_t)-s->part_sign[q];
       ++*turned;
