@@ -90,19 +90,28 @@ set_point(
   b->gt[3 * i] = nx / l, b->gt[3 * i + 1] = ny / l, b->gt[3 * i + 2] = nz / l;
 }
 
+/* The face of nf with areas a that the uniform draw w falls on. */
+static int
+face_by_area(const double* a, int nf, double w)
+{
+  double tot = 0;
+  for (int f = 0; f < nf; ++f)
+    tot += a[f];
+  double r = w * tot;
+  int f = 0;
+  while (f < nf - 1 && r > a[f])
+    r -= a[f++];
+  return f;
+}
+
 /* Sets point i on the thin board (kind 2) from the uniform draws u, v, w. */
 static void
 thin_board_point(block* b, size_t i, double u, double v, double w)
 {
   /* areas: top, bottom 0.12 each; sides 0.008 (x faces 0.006) */
   const double sx = 0.4, sy = 0.3, t = 0.02;
-  double a[6] = {sx * sy, sx * sy, sx * t, sx * t, sy * t, sy * t}, tot = 0;
-  for (int f = 0; f < 6; ++f)
-    tot += a[f];
-  double r = w * tot;
-  int f = 0;
-  while (f < 5 && r > a[f])
-    r -= a[f++];
+  const double a[6] = {sx * sy, sx * sy, sx * t, sx * t, sy * t, sy * t};
+  const int f = face_by_area(a, 6, w);
   double s1 = u - 0.5, s2 = v - 0.5;
   if (f < 2)
     set_point(b, i, sx * s1, sy * s2, f == 0 ? t / 2 : -t / 2, 0, 0, f == 0 ? 1 : -1);
@@ -118,13 +127,8 @@ room_corner_point(block* b, size_t i, double u, double v, double w)
 {
   /* floor [0,1.2]^2 z=0 (+z), wall x=0 (+x), wall y=0 (+y), height 1;
    * box [0.5,0.8]^2 x [0,0.3] on the floor (top and 4 sides, outward) */
-  double a[7] = {1.44, 1.2, 1.2, 0.09, 0.09, 0.09, 0.09}, tot = 0;
-  for (int f = 0; f < 7; ++f)
-    tot += a[f];
-  double r = w * tot;
-  int f = 0;
-  while (f < 6 && r > a[f])
-    r -= a[f++];
+  const double a[7] = {1.44, 1.2, 1.2, 0.09, 0.09, 0.09, 0.09};
+  const int f = face_by_area(a, 7, w);
   double x = 1.2 * u, y = 1.2 * v;
   if (f == 0) {
     if (x > 0.5 && x < 0.8 && y > 0.5 && y < 0.8) { /* under the box: top instead */
