@@ -197,7 +197,13 @@ TEST(PartSign, ClosedPartsAreToldFromOpenOnesAndSayWhichWayIsOut)
 
 // A free-standing board (both faces sampled, 0.6 x 0.4 m, 2 cm thick, with a
 // 1 mm ripple so no offset is exactly 0) is a slab: its faces look away from
-// its mid-plane. A wall patch with a picture on it has one face: left alone.
+// its mid-plane. So is a 10 cm partition seen mostly from one side (a sixth of
+// its face points on the other face). A wall patch with a picture on it (its
+// back looks into the part, the picture out of it) and a surface seen twice
+// 5 mm apart (both copies look the same way) are left alone, and so is a
+// surface seen four times whose outer copies face each other (as after a
+// two-sheet reading) while the middle ones split, and a floor seen from
+// above whose points lie mostly below the middle of their spread.
 TEST(PartSign, SlabPartsSayWhichWayIsOut)
 {
   Shapes s = closedAndOpenShapes();
@@ -210,28 +216,48 @@ TEST(PartSign, SlabPartsSayWhichWayIsOut)
       s.add(25.0 + x, y, 0.0005 * std::sin(3.1 * i + 0.7 * j), 0.0, 0.0, 1.0, 5); // wall
       if (i >= 10 && i < 20 && j >= 5 && j < 15)
         s.add(25.01 + x, y + 0.01, 0.03, 0.0, 0.0, 1.0, 5); // the picture's front
+      const double wobble = 0.001 * std::sin(2.9 * i + 1.3 * j);
+      const double px = 60.0 + 0.04 * i, py = 0.04 * j; // a 1.2 x 0.8 m partition:
+      s.add(px, py, 0.05 + wobble, 0.0, 0.0, 1.0, 7);   // its face seen all over,
+      if (i < 12 && j < 10)                             // a corner of its back
+        s.add(px + 0.02, py + 0.02, -0.05 - wobble, 0.0, 0.0, -1.0, 7);
+      s.add(100.0 + x, y, wobble, 0.0, 0.0, 1.0, 8); // a surface seen twice
+      s.add(100.01 + x, y + 0.01, 0.005 - wobble, 0.0, 0.0, 1.0, 8);
+      for (int c = 0; c < 4; ++c) // four times, 1 cm apart, the outer copies
+        s.add(120.0 + x + 0.005 * c, y, 0.01 * c + wobble, 0.0, 0.0, c ? -1.0 : 1.0, 9);
+      const double low = -0.008 + 0.005 * (0.5 + 0.5 * std::sin(1.3 * i + 3.7 * j));
+      s.add(140.0 + x, y, low, 0.0, 0.0, 1.0, 10); // a floor seen from above, its
+      const double high = 0.0025 * std::sin(0.9 * i + 2.1 * j);
+      if ((i + j) % 5 == 0) // copies' offsets skewed: most low, a few high
+        s.add(140.01 + x, y + 0.01, high, 0.0, 0.0, 1.0, 10);
     }
   addFloor(s, 6);
   const size_t n = s.part.size();
-  int8_t outward[7];
+  int8_t outward[11];
   dacpo_err err = {DACPO_OK, {0}};
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 7, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 11, outward, &err),
             DACPO_OK)
       << err.msg;
   EXPECT_EQ(outward[4], 1) << "board, faces looking away from each other";
   EXPECT_EQ(outward[5], 0) << "a wall with a picture has one face";
   EXPECT_EQ(outward[3], 0) << "a flat square with one face";
   EXPECT_EQ(outward[0], 1) << "the sphere is still told by the closed test";
+  EXPECT_EQ(outward[7], 1) << "a partition seen mostly from one side";
+  EXPECT_EQ(outward[8], 0) << "two copies of one surface";
+  EXPECT_EQ(outward[9], 0) << "four copies, the outer ones facing each other";
+  EXPECT_EQ(outward[10], 0) << "one face, its points mostly below its mid-plane";
   for (size_t i = 0; i < n; ++i)
-    if (s.part[i] == 4 || s.part[i] == 5)
+    if (s.part[i] == 4 || s.part[i] == 5 || s.part[i] == 7 || s.part[i] == 8)
       for (int d = 0; d < 3; ++d)
         s.nrm[3 * i + d] = -s.nrm[3 * i + d];
   ASSERT_EQ(dacpo_part_closed_outward(
-                s.xyz.data(), s.nrm.data(), n, s.part.data(), 7, outward, &err),
+                s.xyz.data(), s.nrm.data(), n, s.part.data(), 11, outward, &err),
             DACPO_OK);
   EXPECT_EQ(outward[4], -1) << "board inside out";
   EXPECT_EQ(outward[5], 0) << "the wall the other way round: still one face";
+  EXPECT_EQ(outward[7], -1) << "the partition inside out";
+  EXPECT_EQ(outward[8], 0) << "the copies the other way round";
 }
 
 // A room scanned from inside (floor and four walls, 6 x 5 x 2.6 m: the

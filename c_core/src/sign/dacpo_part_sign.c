@@ -31,6 +31,8 @@
  */
 #include "dacpo_part_sign.h"
 
+#include "dacpo_select.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -315,39 +317,47 @@ part_extent2(const double* lo, const double* hi, const double* count, size_t q)
  * closed in the sense above (seen from its centroid it fills ~8 of the 26
  * cells, its mean cosine is ~0), yet its faces look away from its mid-plane.
  * Along the part's thinnest principal axis t (its spread at most
- * SLAB_MAX_THIN of the next one), its face points (|n.t| >= SLAB_FACE_COS),
- * at least SLAB_MIN_SIDE of them on each face, vote sign(offset from the
- * centroid along t) x sign(n.t); |mean| >= SLAB_MIN_SCORE gives the sign.
- * Generated room (scene seed 21, 100K, sigma 8 mm, run seed 5): a free-standing
- * partition of 3,110 points, its own part with too few cue points to sign
- * it, was turned inside out by the viewpoint vote (a coin for a two-faced
- * board): its score was -0.985 (ground truth +0.907). A wall with a picture on
- * it has one face (n.t > 0 almost everywhere) and is left alone. Any size: a
- * room is never this thin (its least spread, the height, is about half the
- * next one), and a partition 1.8 m high in a 6 x 5 m room spans more than a
- * quarter of the room, the size up to which a closed part counts as an
- * object. */
+ * SLAB_MAX_THIN of the next one), every face point (|n.t| >= SLAB_FACE_COS)
+ * votes +1 if it looks away from the plane midway between the part's ends
+ * (robust ends: the SLAB_END quantiles of the offsets), -1 if towards it.
+ * Both faces must be there: the face points looking along -t and those
+ * looking along +t each hold a face's worth (SLAB_MIN_POINTS, or on a small part
+ * SLAB_MIN_SIDE of them), of any sizes beyond, so a partition seen mostly from one side
+ * is still two-faced; a surface seen from one side, its points' offsets however skewed,
+ * is not. The part faces out (+1) or in (-1) where the vote is clear
+ * (|mean| >= SLAB_MIN_SCORE) over all its face points and the same in each
+ * band that holds a face's worth: the two outer layers (offsets within
+ * SLAB_LAYER of the span from either end) and the band between them. A wall
+ * with things on it (its back layer looks into the part, the things' fronts
+ * out of it) and a surface seen several times (its copies spread over the
+ * span: after a two-sheet reading the outer ones may face each other, the
+ * middle ones split) give no answer. Any size: a room is never this thin
+ * (its least spread, the height, is about half the next one), and a
+ * partition 1.8 m high in a 6 x 5 m room spans more than a quarter of the
+ * room, the size up to which a closed part counts as an object. */
 #define SLAB_MAX_THIN 0.25
 #define SLAB_FACE_COS 0.7
-#define SLAB_MIN_SIDE 0.25
+#define SLAB_LAYER 0.25
+#define SLAB_END 0.02
 #define SLAB_MIN_SCORE 0.6
 #define SLAB_MIN_POINTS 100
+#define SLAB_MIN_SIDE 0.25
 
-enum { SLAB_WORK = 13 }; /* doubles of work per part, zeroed by the caller */
-
+/* Per part its thinnest principal axis t (axis, 3 per part) where it is a
+ * slab (use[q] = 1), from the points' scatter about the centroids. cov: 6
+ * doubles per part, zeroed by the caller. */
 static void
-slab_parts_outward(const double* xyz,
-                   const double* nrm,
-                   size_t n,
-                   const int32_t* part,
-                   size_t num_parts,
-                   const double* centre,
-                   const double* count,
-                   double* acc,
-                   int8_t* outward)
+slab_axes(const double* xyz,
+          size_t n,
+          const int32_t* part,
+          size_t num_parts,
+          const double* centre,
+          const double* count,
+          const int8_t* outward,
+          double* cov,
+          double* axis,
+          double* use)
 {
-  double *cov = acc, *axis = acc + 6 * num_parts, *vote = acc + 9 * num_parts,
-         *pos = acc + 10 * num_parts, *neg = acc + 11 * num_parts, *use = acc + 12 * num_parts;
   for (size_t i = 0; i < n; ++i) {
     const size_t q = (size_t)part[i];
     const double* c = centre + 3 * q;
@@ -378,27 +388,139 @@ slab_parts_outward(const double* xyz,
       axis[3 * q + d] = v[d][k0];
     use[q] = 1.0;
   }
+}
+
+/* The slab parts' frames: per part its centroid, its thinnest axis t and
+ * whether it is a slab (use[q] != 0). */
+typedef struct slab_frames {
+  const double* centre;
+  const double* axis;
+  double* use;
+} slab_frames;
+
+/* Offset of point i along its part's axis t, and n.t; 0 if i is not a face
+ * point of a slab part. */
+static int
+slab_face_point(const double* xyz,
+                const double* nrm,
+                size_t i,
+                size_t q,
+                const slab_frames* fr,
+                double* off,
+                double* nt)
+{
+  if (fr->use[q] == 0.0)
+    return 0;
+  const double* t = fr->axis + 3 * q;
+  const double* c = fr->centre + 3 * q;
+  *nt = nrm[3 * i] * t[0] + nrm[3 * i + 1] * t[1] + nrm[3 * i + 2] * t[2];
+  *off = (xyz[3 * i] - c[0]) * t[0] + (xyz[3 * i + 1] - c[1]) * t[1] +
+         (xyz[3 * i + 2] - c[2]) * t[2];
+  return fabs(*nt) >= SLAB_FACE_COS;
+}
+
+/* The robust ends lo[q], hi[q] of the slab parts' face point offsets along
+ * their axes (the SLAB_END quantiles); use[q] = 0 for a part without face
+ * points. */
+static dacpo_status
+slab_ends(const double* xyz,
+          const double* nrm,
+          size_t n,
+          const int32_t* part,
+          size_t num_parts,
+          const slab_frames* fr,
+          double* lo,
+          double* hi,
+          dacpo_err* err)
+{
+  double* offs = dacpo_malloc_array(n ? n : 1, sizeof(double));
+  size_t* start = dacpo_calloc_array(num_parts + 1, sizeof(size_t));
+  size_t* fill = dacpo_calloc_array(num_parts + 1, sizeof(size_t));
+  if (!offs || !start || !fill) {
+    free(offs);
+    free(start);
+    free(fill);
+    return DACPO_OOM(err);
+  }
+  double off, nt;
+  for (size_t i = 0; i < n; ++i) /* face points per part, then their offsets by part */
+    start[part[i] + 1] +=
+        (size_t)slab_face_point(xyz, nrm, i, (size_t)part[i], fr, &off, &nt);
+  for (size_t q = 0; q < num_parts; ++q)
+    fill[q + 1] = start[q + 1] += start[q];
+  for (size_t i = 0; i < n; ++i)
+    if (slab_face_point(xyz, nrm, i, (size_t)part[i], fr, &off, &nt))
+      offs[fill[part[i]]++] = off;
+  for (size_t q = 0; q < num_parts; ++q) {
+    const size_t m = start[q + 1] - start[q];
+    if (m == 0) {
+      fr->use[q] = 0.0;
+      continue;
+    }
+    const size_t k = (size_t)(SLAB_END * (double)m);
+    lo[q] = dacpo_select_kth(offs + start[q], m, k);
+    hi[q] = dacpo_select_kth(offs + start[q], m, m - 1 - k);
+  }
+  free(offs);
+  free(start);
+  free(fill);
+  return DACPO_OK;
+}
+
+/* doubles of work per part, zeroed by the caller */
+enum { SLAB_TALLY = 8, SLAB_WORK = 12 + SLAB_TALLY };
+
+static dacpo_status
+slab_parts_outward(const double* xyz,
+                   const double* nrm,
+                   size_t n,
+                   const int32_t* part,
+                   size_t num_parts,
+                   const double* centre,
+                   const double* count,
+                   double* acc,
+                   int8_t* outward,
+                   dacpo_err* err)
+{
+  double *cov = acc, *axis = acc + 6 * num_parts, *use = acc + 9 * num_parts,
+         *lo = acc + 10 * num_parts, *hi = acc + 11 * num_parts,
+         *tally = acc + 12 * num_parts;
+  slab_axes(xyz, n, part, num_parts, centre, count, outward, cov, axis, use);
+  const slab_frames fr = {centre, axis, use};
+  DACPO_TRY(slab_ends(xyz, nrm, n, part, num_parts, &fr, lo, hi, err));
+  /* every face point votes +1 if it looks away from the mid-plane between the
+   * ends; per part, by band (0 the low outer layer, 1 the high one, 2 between
+   * them) the votes t[0..2] and the points t[3..5], and the points whose
+   * normals look along -t and +t, t[6..7] */
+  double off, nt;
   for (size_t i = 0; i < n; ++i) {
     const size_t q = (size_t)part[i];
-    if (use[q] == 0.0)
+    if (!slab_face_point(xyz, nrm, i, q, &fr, &off, &nt))
       continue;
-    const double* t = axis + 3 * q;
-    const double* c = centre + 3 * q;
-    const double off = (xyz[3 * i] - c[0]) * t[0] + (xyz[3 * i + 1] - c[1]) * t[1] +
-                       (xyz[3 * i + 2] - c[2]) * t[2];
-    const double nt = nrm[3 * i] * t[0] + nrm[3 * i + 1] * t[1] + nrm[3 * i + 2] * t[2];
-    if (fabs(nt) < SLAB_FACE_COS || off == 0.0)
-      continue;
-    (nt > 0.0 ? pos : neg)[q] += 1.0;
-    vote[q] += (off > 0.0) == (nt > 0.0) ? 1.0 : -1.0;
+    double* t = tally + SLAB_TALLY * q;
+    const double layer = SLAB_LAYER * (hi[q] - lo[q]);
+    const int band = off <= lo[q] + layer ? 0 : (off >= hi[q] - layer ? 1 : 2);
+    const int above = off > 0.5 * (lo[q] + hi[q]);
+    t[band] += above == (nt > 0.0) ? 1.0 : -1.0;
+    t[3 + band] += 1.0;
+    t[6 + (nt > 0.0)] += 1.0;
   }
   for (size_t q = 0; q < num_parts; ++q) {
-    const double faces = pos[q] + neg[q];
-    if (use[q] == 0.0 || !(faces > 0.0) || pos[q] < SLAB_MIN_SIDE * faces ||
-        neg[q] < SLAB_MIN_SIDE * faces || fabs(vote[q]) < SLAB_MIN_SCORE * faces)
+    const double* t = tally + SLAB_TALLY * q;
+    const double all = t[3] + t[4] + t[5], vote = t[0] + t[1] + t[2];
+    /* a face's worth: SLAB_MIN_POINTS, or SLAB_MIN_SIDE of a small part's */
+    const double face = fmin(SLAB_MIN_POINTS, SLAB_MIN_SIDE * all);
+    if (use[q] == 0.0 || !(hi[q] > lo[q]) || t[6] < face || t[7] < face ||
+        fabs(vote) < SLAB_MIN_SCORE * all)
       continue;
-    outward[q] = vote[q] > 0.0 ? 1 : -1;
+    const double way = vote > 0.0 ? 1.0 : -1.0;
+    int agree = 1; /* and each band that holds a face's worth */
+    for (int k = 0; k < 3; ++k)
+      agree &= t[3 + k] < face || way * t[k] >= SLAB_MIN_SCORE * t[3 + k];
+    if (agree)
+      outward[q] = (int8_t)way;
   }
+  return DACPO_OK;
 }
 
 /* Per part its centroid, point count and bounding box. */
@@ -485,9 +607,9 @@ dacpo_part_closed_outward(const double* xyz,
         extent <= CLOSED_MAX_EXTENT * CLOSED_MAX_EXTENT * all)
       outward[q] = mc > 0.0 ? 1 : -1;
   }
-  slab_parts_outward(
-      xyz, nrm, n, part, num_parts, centre, count, acc + 11 * num_parts, outward);
+  const dacpo_status r = slab_parts_outward(
+      xyz, nrm, n, part, num_parts, centre, count, acc + 11 * num_parts, outward, err);
   free(acc);
   free(cells);
-  return DACPO_OK;
+  return r;
 }

@@ -82,10 +82,11 @@ dacpo_view_candidate(const dacpo_view_sample* s, dacpo_rng* rng, size_t k, doubl
 
 /* Parts that wrap around their own centroid (closed objects, at most a
  * quarter of the widest part's size), and flat parts with two faces of any
- * size (a free-standing board, a partition: its faces look away from its
- * mid-plane): outward[c] = +1 if their normals (nrm, as they will be returned)
- * face outward, -1 if inward, 0 for every other part. Failures: NULL argument (INVALID_ARGUMENT),
- * OUT_OF_MEMORY. */
+ * size, however unequal (a free-standing board, a partition: its faces look
+ * away from its mid-plane), the largest part included: outward[c] = +1 if
+ * their normals (nrm, as they will be returned) face outward, -1 if inward,
+ * 0 for every other part and where the evidence is not clear. Failures: NULL argument
+ * (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_part_closed_outward(const double* xyz,
                           const double* nrm,

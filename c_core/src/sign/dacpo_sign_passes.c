@@ -644,33 +644,31 @@ relate_parts(run_state* s, dacpo_stats* st, dacpo_err* err)
   return r;
 }
 
-/* A part other than the largest that wraps around its own centroid is a
- * closed object seen from all round, which the viewpoint vote cannot place
- * (half its points face any viewpoint), and so is a flat part with two faces
- * (a free-standing board): after stage 6 it takes the sign under which it
- * faces outward (dacpo_part_closed_outward). The side cue, where it
- * speaks, still has the last word (parts_follow_the_cue runs after). */
+/* A part that wraps around its own centroid is a closed object seen from all
+ * round, which the viewpoint vote cannot place (half its points face any
+ * viewpoint), and so is a flat part with two faces (a free-standing board, a
+ * partition): after stage 6 it takes the sign under which it faces outward
+ * (dacpo_part_closed_outward). The largest part too: it is the reference the
+ * vote relates the others to, and a partition seen from both sides can be the
+ * largest part of a scan, its sign then only as right as the vote's guess.
+ * The side cue, where it speaks, still has the last word
+ * (parts_follow_the_cue runs after). */
 static dacpo_status
 closed_parts_outward(run_state* s, size_t np, dacpo_err* err)
 {
   const size_t n = s->cloud.n;
   double* now = current_normals(s);
   int8_t* outward = dacpo_malloc_array(np, sizeof(int8_t));
-  size_t* size = dacpo_calloc_array(np, sizeof(size_t));
-  dacpo_status r = now && outward && size ? DACPO_OK : DACPO_OOM(err);
+  dacpo_status r = now && outward ? DACPO_OK : DACPO_OOM(err);
   for (size_t i = 0; r == DACPO_OK && i < 3 * n; ++i)
     now[i] *= s->global_sign;
   if (r == DACPO_OK)
     r = dacpo_part_closed_outward(s->cloud.xyz, now, n, s->part, np, outward, err);
-  if (r == DACPO_OK) {
-    const size_t big = dacpo_part_largest(s->part, n, np, size);
-    for (size_t q = 0; q < np; ++q)
-      if (q != big && outward[q] < 0)
-        s->part_sign[q] = (int8_t)-s->part_sign[q];
-  }
+  for (size_t q = 0; r == DACPO_OK && q < np; ++q)
+    if (outward[q] < 0)
+      s->part_sign[q] = (int8_t)-s->part_sign[q];
   free(now);
   free(outward);
-  free(size);
   return r;
 }
 
