@@ -321,20 +321,21 @@ part_extent2(const double* lo, const double* hi, const double* count, size_t q)
  * votes +1 if it looks away from the plane midway between the part's ends
  * (robust ends: the SLAB_END quantiles of the offsets), -1 if towards it.
  * Both faces must be there: the face points looking along -t and those
- * looking along +t each hold a face's worth (SLAB_MIN_POINTS, or on a small part
- * SLAB_MIN_SIDE of them), of any sizes beyond, so a partition seen mostly from one side
- * is still two-faced; a surface seen from one side, its points' offsets however skewed,
- * is not. The part faces out (+1) or in (-1) where the vote is clear
- * (|mean| >= SLAB_MIN_SCORE) over all its face points and the same in each
- * band that holds a face's worth: the two outer layers (offsets within
- * SLAB_LAYER of the span from either end) and the band between them. A wall
- * with things on it (its back layer looks into the part, the things' fronts
- * out of it) and a surface seen several times (its copies spread over the
- * span: after a two-sheet reading the outer ones may face each other, the
- * middle ones split) give no answer. Any size: a room is never this thin
- * (its least spread, the height, is about half the next one), and a
- * partition 1.8 m high in a 6 x 5 m room spans more than a quarter of the
- * room, the size up to which a closed part counts as an object. */
+ * looking along +t each hold a face's worth (SLAB_MIN_POINTS, or on a small
+ * part SLAB_MIN_SIDE of them), of any sizes beyond, so a partition seen
+ * mostly from one side is still two-faced; a surface seen from one side, its
+ * points' offsets however skewed, is not. The part faces out (+1) or in (-1)
+ * where the vote is clear (|mean| >= SLAB_MIN_SCORE) over all its face
+ * points, each of its two outer layers (offsets within SLAB_LAYER of the
+ * span from either end) votes the same way, and the band between them, where
+ * it holds a face's worth, is as clear as the whole. A wall with things on it
+ * (its back layer looks into the part, the things' fronts out of it) and a
+ * surface seen several times (its copies spread over the span: after a
+ * two-sheet reading the outer ones may face each other, the middle ones
+ * split) give no answer. Any size: a room is never this thin (its least
+ * spread, the height, is about half the next one), and a partition 1.8 m
+ * high in a 6 x 5 m room spans more than a quarter of the room, the size up
+ * to which a closed part counts as an object. */
 #define SLAB_MAX_THIN 0.25
 #define SLAB_FACE_COS 0.7
 #define SLAB_LAYER 0.25
@@ -514,9 +515,10 @@ slab_parts_outward(const double* xyz,
         fabs(vote) < SLAB_MIN_SCORE * all)
       continue;
     const double way = vote > 0.0 ? 1.0 : -1.0;
-    int agree = 1; /* and each band that holds a face's worth */
-    for (int k = 0; k < 3; ++k)
-      agree &= t[3 + k] < face || way * t[k] >= SLAB_MIN_SCORE * t[3 + k];
+    /* each face agrees, and the band between them, where it holds a face's
+     * worth, is as clear as the whole */
+    int agree = way * t[0] > 0.0 && way * t[1] > 0.0;
+    agree &= t[5] < face || way * t[2] >= SLAB_MIN_SCORE * t[5];
     if (agree)
       outward[q] = (int8_t)way;
   }
