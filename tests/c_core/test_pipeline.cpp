@@ -435,8 +435,9 @@ TEST(DacpoPipeline, AFewCopiesOfAWallDoNotTurnItsPart)
 // 10 cm partition seen from both sides, mostly from one (its faces hold about
 // 20,000 and 2,300 points), is the largest part of the scan, the one the
 // viewpoint vote relates the others to. Stage 5 left it inside out, the vote
-// kept it so, and 26,965 points came out wrong (27.25 %); as a slab whose two
-// outer layers both look into it, it is turned over after the global sign.
+// kept it so, and 26,965 points came out wrong (27.25 %); as a slab whose
+// face points, both faces and the band between them, vote that they look
+// into it, it is turned over after the global sign.
 TEST(DacpoPipeline, APartitionThatIsTheLargestPartFacesOut)
 {
   Result r;
