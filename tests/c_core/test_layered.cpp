@@ -327,6 +327,38 @@ TEST(DacpoLayered, PipelineLeavesTheCueOutOnFusedRooms)
 
 namespace {
 
+// A small linear congruential stream of uniforms in [0, 1) (seeded per test).
+struct Uniform {
+  uint64_t st;
+  double
+  operator()()
+  {
+    st = st * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(st >> 11) / 9007199254740992.0;
+  }
+};
+
+// % wrong of xyz (ground truth gt) after orientation from PCA axes (AUTO, seed).
+double
+orientCopies(std::vector<float>& xyz, const std::vector<float>& gt, uint64_t seed)
+{
+  const size_t n = xyz.size() / 3;
+  std::vector<float> nrm(xyz.size(), 0.0f);
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.estimate_normals = 1;
+  p.seed = seed;
+  dacpo_ctx* ctx = nullptr;
+  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+  const dacpo_status s =
+      dacpo_orient(ctx, &p, nullptr, nullptr, xyz.data(), nrm.data(), n);
+  EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
+  dacpo_ctx_free(ctx);
+  return s == DACPO_OK
+             ? dacpo_score_oriented(gt.data(), nrm.data(), n, nullptr, nullptr)
+             : 100.0;
+}
+
 // Two copies of one 1 m x 1 m plane (random samples, 2 cm mean spacing), the
 // second `gap` spacings above the first and turned by `tilt` degrees about an
 // in-plane axis (so the copies cross when gap is small); both face +z.
@@ -337,11 +369,7 @@ orientPlaneCopies(double gap, double tilt, uint64_t seed)
   const size_t half = 2500;
   const double h = 0.02;
   std::vector<float> xyz, gt;
-  uint64_t st = seed * 0x9E3779B97F4A7C15ull + 1;
-  auto uniform = [&st]() {
-    st = st * 6364136223846793005ull + 1442695040888963407ull;
-    return (double)(st >> 11) / 9007199254740992.0;
-  };
+  Uniform uniform{seed * 0x9E3779B97F4A7C15ull + 1};
   const double a = tilt * M_PI / 180.0;
   for (int copy = 0; copy < 2; ++copy)
     for (size_t i = 0; i < half; ++i) {
@@ -351,22 +379,61 @@ orientPlaneCopies(double gap, double tilt, uint64_t seed)
       xyz.insert(xyz.end(), {(float)xx, (float)y, (float)z});
       gt.insert(gt.end(), {copy ? (float)-std::sin(a) : 0.0f, 0.0f, copy ? (float)std::cos(a) : 1.0f});
     }
-  std::vector<float> nrm(xyz.size(), 0.0f);
-  dacpo_params p;
-  dacpo_params_init(&p);
-  p.estimate_normals = 1;
-  p.seed = seed;
-  dacpo_ctx* ctx = nullptr;
-  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  const dacpo_status s =
-      dacpo_orient(ctx, &p, nullptr, nullptr, xyz.data(), nrm.data(), 2 * half);
-  EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
-  dacpo_ctx_free(ctx);
-  return s == DACPO_OK ? dacpo_score_oriented(gt.data(), nrm.data(), 2 * half, nullptr, nullptr)
-                       : 100.0;
+  return orientCopies(xyz, gt, seed);
+}
+
+// Two copies of a box corner seen from inside (three 1 m x 1 m faces on the
+// planes x = 0, y = 0, z = 0, facing +x, +y, +z; 2,500 random samples each,
+// 2 cm mean spacing), the second moved by `gap` spacings along (1, 1, 1) /
+// sqrt(3) and turned by `tilt` degrees about the y axis through the box's
+// middle. Returns % wrong after orientation from PCA axes (AUTO, seed).
+double
+orientCornerCopies(double gap, double tilt, uint64_t seed)
+{
+  const size_t per_face = 2500;
+  const double h = 0.02, a = tilt * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+  const double shift = gap * h / std::sqrt(3.0);
+  std::vector<float> xyz, gt;
+  Uniform uniform{seed * 0x9E3779B97F4A7C15ull + 7};
+  for (int copy = 0; copy < 2; ++copy)
+    for (int axis = 0; axis < 3; ++axis)
+      for (size_t i = 0; i < per_face; ++i) {
+        double p[3], n[3] = {0.0, 0.0, 0.0};
+        p[axis] = 0.0;
+        p[(axis + 1) % 3] = uniform();
+        p[(axis + 2) % 3] = uniform();
+        n[axis] = 1.0;
+        if (copy) { // turn about y through (0.5, 0.5, 0.5), then shift
+          const double x = p[0] - 0.5, z = p[2] - 0.5;
+          p[0] = c * x + s * z + 0.5 + shift;
+          p[1] += shift;
+          p[2] = -s * x + c * z + 0.5 + shift;
+          const double nx = n[0], nz = n[2];
+          n[0] = c * nx + s * nz;
+          n[2] = -s * nx + c * nz;
+        }
+        xyz.insert(xyz.end(), {(float)p[0], (float)p[1], (float)p[2]});
+        gt.insert(gt.end(), {(float)n[0], (float)n[1], (float)n[2]});
+      }
+  return orientCopies(xyz, gt, seed);
 }
 
 } // namespace
+
+// Copies of a box corner (a room's corner: each face has the other two on one
+// side, so none can be a thin solid's face) keep one orientation: the layered
+// test reads the copies on a face with the scene on one side. Measured (seed
+// 1): 0.00-0.01 % wrong at every gap and tilt below; with the test skipped
+// (MULTI_VIEW given) 49.6-49.9 %, the copies facing away from each other.
+TEST(DacpoLayered, TwoCopiesOfABoxCornerKeepOneOrientation)
+{
+  for (double gap : {0.3, 0.8, 1.5})
+    for (double tilt : {0.0, 0.5}) {
+      const double wrong = orientCornerCopies(gap, tilt, 1);
+      printf("corner copies gap %.1f tilt %.1f: %.2f %% wrong\n", gap, tilt, wrong);
+      EXPECT_LE(wrong, 2.0) << "gap " << gap << " tilt " << tilt;
+    }
+}
 
 // Known failure (issue: copies or thin solids): two copies of a plane with
 // nothing else in the scene are read as the two faces of a thin board, which
