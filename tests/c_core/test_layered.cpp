@@ -132,8 +132,11 @@ TEST(DacpoLayered, FusedRoomShowsCopiesAPlainOneDoesNot)
 // them, but most of the floor is doubled within the slab. Here every second
 // point of a generated room is lifted by `lift` spacings (its walls slide
 // along themselves); a thing resting on a floor covers only a part of it.
-// (Through the pipeline each copy of the floor holds half its points and a
-// wall's band holds more: CopiesOnTheFloorCountWhenAWallBandIsFuller.)
+// (Through the pipeline this room does not show it: each copy of the floor
+// holds half its points, a wall's band then holds more, and the walls, slid
+// along themselves, show no copies; fz_lr_a_n20's lowest floor copy stays the
+// largest band. Reading every band's doubled share was measured and not kept:
+// docs/DESIGN.md, "every one-sided band".)
 TEST(DacpoLayered, CopiesWiderThanThePairWindowDoubleTheFloor)
 {
   for (uint64_t seed = 1; seed <= 2; ++seed) {
@@ -159,37 +162,6 @@ TEST(DacpoLayered, CopiesWiderThanThePairWindowDoubleTheFloor)
       EXPECT_GE(doubled, DACPO_LAYERED_DOUBLED) << "seed " << seed << " lift " << lift;
       EXPECT_LT(pd, 0.25 * DACPO_LAYERED_DOUBLED) << "seed " << seed;
     }
-  }
-}
-
-// The same lifted room through the pipeline (PCA axes): each copy of the floor
-// holds half of it, so the fullest band is a wall, which shows no copies (its
-// copies slide along it). Every band with the scene on one side is read for
-// copies, so the floor's are found and the copies keep one orientation.
-// Measured (scene seed 1, run seed 1): the plain room 1.55 %; lifted 4 / 6
-// spacings 17.86 / 24.07 % when only the fullest band was read (doubled 0),
-// 7.33 / 7.32 % now (doubled 0.975 / 0.989).
-TEST(DacpoLayered, CopiesOnTheFloorCountWhenAWallBandIsFuller)
-{
-  GeneratedScene plain(roomParams(100000, 0, 1));
-  ASSERT_TRUE(plain.ok);
-  const size_t n = plain.s.n;
-  const double spacing = 0.0157; // as in CopiesWiderThanThePairWindowDoubleTheFloor
-  for (double lift : {4.0, 6.0}) {
-    std::vector<float> xyz(plain.s.xyz, plain.s.xyz + 3 * n);
-    for (size_t i = 1; i < n; i += 2)
-      xyz[3 * i + 2] += (float)(lift * spacing);
-    dacpo_scene lifted = plain.s; // borrows the arrays; plain frees them
-    lifted.xyz = xyz.data();
-    dacpo_stats st{};
-    const double wrong = orientScore(lifted, DACPO_SCAN_AUTO, &st);
-    printf("floor lifted %.0f spacings: doubled %.3f, copies %.3f, %.2f %% wrong\n",
-           lift,
-           st.layered_doubled,
-           st.layered_copies,
-           wrong);
-    EXPECT_GE(st.layered_doubled, DACPO_LAYERED_DOUBLED) << "lift " << lift;
-    EXPECT_LE(wrong, 10.0) << "lift " << lift;
   }
 }
 
@@ -423,7 +395,7 @@ orientCornerCopies(double gap, double tilt, uint64_t seed)
 // Copies of a box corner (a room's corner: each face has the other two on one
 // side, so none can be a thin solid's face) keep one orientation: the layered
 // test reads the copies on a face with the scene on one side. Measured (seed
-// 1): 0.00-0.01 % wrong at every gap and tilt below; with the test skipped
+// 1): 0.00-0.02 % wrong at every gap and tilt below; with the test skipped
 // (MULTI_VIEW given) 49.6-49.9 %, the copies facing away from each other.
 TEST(DacpoLayered, TwoCopiesOfABoxCornerKeepOneOrientation)
 {

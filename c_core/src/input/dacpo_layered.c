@@ -28,10 +28,7 @@
  * parallel sheet within two spacings (stage 2's two-sheet pair test): on a
  * room's floor that happens only where a thing rests a spacing above it, on a
  * fused floor everywhere. From DACPO_LAYERED_COPIES on the two-sheet rule goes
- * too. It is read on every main direction's band that has the scene on one
- * side, not only the fullest: copies a few spacings apart split a floor into
- * sheets of half its points, and a wall's band, whose copies slide along it,
- * is then the fullest.
+ * too.
  *
  * Cost: O(n) passes plus a kd-tree over the slab's points and the side test on
  * the sample (a few milliseconds on 100K points). Deterministic.
@@ -65,14 +62,6 @@
 #define LAYERED_UNDER 0.5
 /* ... its box grown by this share of its smaller side. */
 #define LAYERED_UNDER_MARGIN 0.1
-
-/* A band: the slab [lo, lo + width] along unit direction dir, and how many
- * probe points with axes along dir it holds. */
-typedef struct {
-  double dir[3];
-  double lo;
-  size_t count;
-} layered_band;
 
 static double
 dot3(const double* a, const double* b)
@@ -210,19 +199,19 @@ densest_window(const double* h, size_t m, double width, double* lo)
   return best;
 }
 
-/* The fullest slab along each main direction (a band): direction, slab [lo,
- * lo + width] and probe count, fullest first. Returns how many were found. */
+/* The band: direction *dir, slab [*lo, *lo + width]; returns its probe count. */
 static size_t
-find_bands(const double* xyz,
-           const double* axes,
-           const size_t* probe,
-           size_t m,
-           double width,
-           double* h,
-           layered_band* out)
+find_band(const double* xyz,
+          const double* axes,
+          const size_t* probe,
+          size_t m,
+          double width,
+          double* h,
+          double dir[3],
+          double* lo)
 {
   double dirs[LAYERED_DIRECTIONS][3];
-  size_t found = 0;
+  size_t best_band = 0;
   for (int r = 0; r < LAYERED_DIRECTIONS; ++r) {
     /* the most common axis among the probe points off the earlier directions */
     size_t best = 0, best_c = 0;
@@ -266,17 +255,15 @@ find_bands(const double* xyz,
       if (fabs(dot3(dirs[r], axes + 3 * probe[t])) > LAYERED_COS)
         h[k++] = dot3(dirs[r], xyz + 3 * probe[t]);
     qsort(h, k, sizeof(double), dacpo_cmp_double);
-    layered_band* b = &out[found];
-    b->count = densest_window(h, k, width, &b->lo);
-    memcpy(b->dir, dirs[r], sizeof(b->dir));
-    /* fullest first */
-    for (size_t t = found++; t > 0 && out[t].count > out[t - 1].count; --t) {
-      const layered_band tmp = out[t];
-      out[t] = out[t - 1];
-      out[t - 1] = tmp;
+    double at = 0.0;
+    const size_t count = densest_window(h, k, width, &at);
+    if (count > best_band) {
+      best_band = count;
+      memcpy(dir, dirs[r], 3 * sizeof(double));
+      *lo = at;
     }
   }
-  return found;
+  return best_band;
 }
 
 /* 1 if the band [lo, lo + width] along dir lies under the scene: at least
@@ -510,17 +497,18 @@ minority_under_band(const double* xyz,
 }
 
 /* The spacing (median nearest-neighbour distance over a probe of the points)
- * and the bands of find_bands, *bands of them (0: none). */
+ * and the band of find_band, its probe count in *band (0: none). */
 static dacpo_status
-probe_bands(const double* xyz,
-            const double* axes,
-            size_t n,
-            const float* knn_sqd,
-            size_t knn_k,
-            double* spacing,
-            layered_band* out,
-            size_t* bands,
-            dacpo_err* err)
+probe_band(const double* xyz,
+           const double* axes,
+           size_t n,
+           const float* knn_sqd,
+           size_t knn_k,
+           double* spacing,
+           double dir[3],
+           double* lo,
+           size_t* band,
+           dacpo_err* err)
 {
   const size_t m = n < LAYERED_PROBE ? n : LAYERED_PROBE;
   size_t* probe = dacpo_malloc_array(m, sizeof(size_t));
@@ -538,9 +526,9 @@ probe_bands(const double* xyz,
       h[finite++] = sqrt(d2);
   }
   *spacing = finite ? dacpo_select_kth(h, finite, finite / 2) : 0.0;
-  *bands = *spacing > 0.0
-               ? find_bands(xyz, axes, probe, m, LAYERED_BAND * *spacing, h, out)
-               : 0;
+  *band = *spacing > 0.0
+              ? find_band(xyz, axes, probe, m, LAYERED_BAND * *spacing, h, dir, lo)
+              : 0;
   free(probe);
   free(h);
   return DACPO_OK;
@@ -663,49 +651,6 @@ side_share(const double* xyz,
   return st;
 }
 
-/* Whether the band [lo, lo + width] along dir has the scene on one side
- * (enough points beyond its slab, hardly any of them under it on the other
- * side); *ns, *nb_band: the points in its slab and in the band. */
-static dacpo_status
-one_sided(const double* xyz,
-          const double* axes,
-          size_t n,
-          const double dir[3],
-          double lo,
-          double width,
-          size_t* ns,
-          size_t* nb_band,
-          int* yes,
-          dacpo_err* err)
-{
-  size_t below = 0, above = 0;
-  *ns = *nb_band = 0;
-  *yes = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const double y = dot3(dir, xyz + 3 * i);
-    if (y < lo - width)
-      below++;
-    else if (y > lo + 2.0 * width)
-      above++;
-    else {
-      (*ns)++;
-      *nb_band += in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
-    }
-  }
-  /* Only a plane with the scene on one side of it, like a floor or a wall
-   * seen from inside, cannot be a thin solid: a board or a partition has
-   * things on both sides, or nothing at all (a scan of one board). */
-  const size_t beyond = below + above;
-  size_t minority = 0;
-  if (*nb_band < DACPO_LAYERED_MIN_BAND ||
-      (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n)
-    return DACPO_OK;
-  DACPO_TRY(
-      minority_under_band(xyz, axes, n, dir, lo, width, below < above, &minority, err));
-  *yes = (double)minority <= DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond;
-  return DACPO_OK;
-}
-
 dacpo_status
 dacpo_layered_share(const double* xyz,
                     const double* axes,
@@ -727,43 +672,53 @@ dacpo_layered_share(const double* xyz,
   *doubled = 0.0;
   if (n <= LAYERED_K || knn_k < LAYERED_PAIRS)
     return DACPO_OK;
-  double spacing = 0.0;
-  layered_band band[LAYERED_DIRECTIONS];
-  size_t bands = 0;
-  DACPO_TRY(probe_bands(xyz, axes, n, knn_sqd, knn_k, &spacing, band, &bands, err));
+  double spacing = 0.0, dir[3] = {0.0, 0.0, 0.0}, lo = 0.0;
+  size_t band = 0;
+  DACPO_TRY(probe_band(xyz, axes, n, knn_sqd, knn_k, &spacing, dir, &lo, &band, err));
   const double width = LAYERED_BAND * spacing;
-  /* Copies: on every band that has the scene on one side and lies under it (a
-   * floor, a wall): wherever copies lie in one of them, they are copies. The
-   * side test: on the fullest band only. */
-  for (size_t b = 0; b < bands && band[b].count >= DACPO_LAYERED_MIN_BAND; ++b) {
-    const double* dir = band[b].dir;
-    const double lo = band[b].lo;
-    size_t ns = 0, nb_band = 0;
-    int yes = 0;
-    DACPO_TRY(one_sided(xyz, axes, n, dir, lo, width, &ns, &nb_band, &yes, err));
-    if (!yes)
-      continue;
-    double rate = 0.0, stacked = 0.0;
-    if (under_scene(xyz, axes, n, dir, lo, width))
-      DACPO_TRY(copy_rates(xyz,
-                           axes,
-                           n,
-                           knn_idx,
-                           knn_sqd,
-                           knn_k,
-                           dir,
-                           lo,
-                           width,
-                           nb_band,
-                           spacing,
-                           &rate,
-                           &stacked,
-                           err));
-    *copies = fmax(*copies, rate);
-    *doubled = fmax(*doubled, stacked);
-    if (b == 0)
-      DACPO_TRY(
-          side_share(xyz, axes, n, dir, lo, width, ns, nb_band, spacing, share, err));
+  if (band < DACPO_LAYERED_MIN_BAND)
+    return DACPO_OK;
+
+  /* the slab around the band (any axis: the neighbours), its band points, and
+   * the points beyond the slab on either side */
+  size_t ns = 0, nb_band = 0, below = 0, above = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double y = dot3(dir, xyz + 3 * i);
+    if (y < lo - width)
+      below++;
+    else if (y > lo + 2.0 * width)
+      above++;
+    else {
+      ns++;
+      nb_band += in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
+    }
   }
-  return DACPO_OK;
+  /* Only a plane with the scene on one side of it, like a floor or a wall
+   * seen from inside, cannot be a thin solid: a board or a partition has
+   * things on both sides, or nothing at all (a scan of one board). */
+  const size_t beyond = below + above;
+  size_t minority = 0;
+  if (nb_band < DACPO_LAYERED_MIN_BAND ||
+      (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n)
+    return DACPO_OK;
+  DACPO_TRY(
+      minority_under_band(xyz, axes, n, dir, lo, width, below < above, &minority, err));
+  if ((double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
+    return DACPO_OK;
+  if (under_scene(xyz, axes, n, dir, lo, width))
+    DACPO_TRY(copy_rates(xyz,
+                         axes,
+                         n,
+                         knn_idx,
+                         knn_sqd,
+                         knn_k,
+                         dir,
+                         lo,
+                         width,
+                         nb_band,
+                         spacing,
+                         copies,
+                         doubled,
+                         err));
+  return side_share(xyz, axes, n, dir, lo, width, ns, nb_band, spacing, share, err);
 }

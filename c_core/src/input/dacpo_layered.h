@@ -16,17 +16,14 @@
  * values measured). 0 when no band holds DACPO_LAYERED_MIN_BAND
  * sampled points or the scene lies on both sides of it.
  *
- * *copies (the copy rate): the largest over the bands of the three main
- * directions (the fullest slab along each) that have the scene on one side
- * and lie under it (a floor, a wall), of the share of up to
- * DACPO_LAYERED_SAMPLE points of the band's surface itself (the densest slab
- * one spacing thick in it) that have a second parallel sheet within two
- * spacings: stage 2's two-sheet pair test. Copies split a floor into sheets
- * of half its points each, so a wall's band can be the fullest; the floor is
- * read all the same. *doubled: likewise, the share of the same points with a
- * second parallel sheet anywhere in the slab (up to two band widths from
- * them, among their nearest in the plane): copies wider apart than the pair
- * window, as whole frames off by 2 cm. Both 0 where no band qualifies.
+ * *copies (the copy rate): on the same band, if it qualifies, the share of up
+ * to DACPO_LAYERED_SAMPLE points of the surface itself (the densest slab one
+ * spacing thick in the band) that have a second parallel sheet within two
+ * spacings: stage 2's two-sheet pair test. *doubled: the share of the same
+ * points with a second parallel sheet anywhere in the slab (up to two band
+ * widths from them, among their nearest in the plane): copies wider apart
+ * than the pair window, as whole frames off by 2 cm. Both 0 where *share is 0
+ * for want of a band.
  *
  * xyz, axes: n points and unit axes (3n each); knn_idx, knn_sqd: n x knn_k
  * nearest neighbours (self excluded, nearest first, -1 / inf padded) and their
