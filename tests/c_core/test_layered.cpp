@@ -396,7 +396,7 @@ orientCornerCopies(double gap, double tilt, uint64_t seed)
 // side, so none can be a thin solid's face) keep one orientation: the layered
 // test reads the copies on a face with the scene on one side. Measured (seed
 // 1): 0.00-0.02 % wrong at every gap and tilt below; with the test skipped
-// (MULTI_VIEW given) 49.6-49.9 %, the copies facing away from each other.
+// (MULTI_VIEW given) 40.2-49.7 %, the copies facing away from each other.
 TEST(DacpoLayered, TwoCopiesOfABoxCornerKeepOneOrientation)
 {
   for (double gap : {0.3, 0.8, 1.5})
