@@ -83,24 +83,37 @@ shareOf(const float* xyzf,
   return share;
 }
 
-// % wrong of the scene oriented by the public API from unsigned PCA normals.
+// % wrong of n points (ground truth gt) oriented by the public API from
+// unsigned PCA normals; the run's stats in *stats.
 double
-orientScore(const dacpo_scene& sc, dacpo_scan_kind kind, dacpo_stats* stats)
+orientPoints(const float* xyz,
+             const float* gt,
+             size_t n,
+             dacpo_scan_kind kind,
+             uint64_t seed,
+             dacpo_stats* stats)
 {
-  std::vector<float> nrm(3 * sc.n, 0.0f);
+  std::vector<float> nrm(3 * n, 0.0f);
   dacpo_params p;
   dacpo_params_init(&p);
   p.estimate_normals = 1;
   p.scan_kind = kind;
-  p.seed = 1;
+  p.seed = seed;
   dacpo_ctx* ctx = nullptr;
   EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  const dacpo_status s = dacpo_orient(ctx, &p, nullptr, nullptr, sc.xyz, nrm.data(), sc.n);
+  const dacpo_status s = dacpo_orient(ctx, &p, nullptr, nullptr, xyz, nrm.data(), n);
   EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
   *stats = *dacpo_ctx_stats(ctx);
   dacpo_ctx_free(ctx);
-  return s == DACPO_OK ? dacpo_score_oriented(sc.normals, nrm.data(), sc.n, nullptr, nullptr)
+  return s == DACPO_OK ? dacpo_score_oriented(gt, nrm.data(), n, nullptr, nullptr)
                        : 100.0;
+}
+
+// The scene oriented as above (run seed 1).
+double
+orientScore(const dacpo_scene& sc, dacpo_scan_kind kind, dacpo_stats* stats)
+{
+  return orientPoints(sc.xyz, sc.normals, sc.n, kind, 1, stats);
 }
 
 } // namespace
@@ -312,23 +325,11 @@ struct Uniform {
 
 // % wrong of xyz (ground truth gt) after orientation from PCA axes (AUTO, seed).
 double
-orientCopies(std::vector<float>& xyz, const std::vector<float>& gt, uint64_t seed)
+orientCopies(const std::vector<float>& xyz, const std::vector<float>& gt, uint64_t seed)
 {
-  const size_t n = xyz.size() / 3;
-  std::vector<float> nrm(xyz.size(), 0.0f);
-  dacpo_params p;
-  dacpo_params_init(&p);
-  p.estimate_normals = 1;
-  p.seed = seed;
-  dacpo_ctx* ctx = nullptr;
-  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  const dacpo_status s =
-      dacpo_orient(ctx, &p, nullptr, nullptr, xyz.data(), nrm.data(), n);
-  EXPECT_EQ(s, DACPO_OK) << dacpo_ctx_last_error(ctx);
-  dacpo_ctx_free(ctx);
-  return s == DACPO_OK
-             ? dacpo_score_oriented(gt.data(), nrm.data(), n, nullptr, nullptr)
-             : 100.0;
+  dacpo_stats st{};
+  return orientPoints(
+      xyz.data(), gt.data(), xyz.size() / 3, DACPO_SCAN_AUTO, seed, &st);
 }
 
 // Two copies of one 1 m x 1 m plane (random samples, 2 cm mean spacing), the
