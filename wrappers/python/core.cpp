@@ -254,6 +254,8 @@ statsDict(const dacpo_stats* s)
   stats["parts_cue_signed"] = s->parts_cue_signed;
   stats["surface_vote_turned"] = s->surface_vote_turned;
   stats["sensor_turned"] = s->sensor_turned;
+  stats["frame_sensors"] = s->frame_sensors;
+  stats["frame_turned"] = s->frame_turned;
   stats["cue_reconciled_blocks"] = s->cue_reconciled_blocks;
   stats["view_score"] = s->view_score;
   stats["sign_flipped"] = s->sign_flipped != 0;

@@ -240,7 +240,8 @@ printStats(const Result& result)
                "stats: points=%zu blocks=%zu edges=%zu low_conf_edges=%zu "
                "components=%zu parts=%zu parts_related=%zu view_score=%.3f flipped=%zu "
                "cue_anchored=%zu parts_cue_signed=%zu cue_reconciled=%zu "
-               "surface_turned=%zu sensor_turned=%zu scan=%s single_view_fit=%.3f c=%g "
+               "surface_turned=%zu sensor_turned=%zu frame_sensors=%zu "
+               "frame_turned=%zu scan=%s single_view_fit=%.3f c=%g "
                "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f "
                "copy_axes=%zu sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
@@ -262,6 +263,8 @@ printStats(const Result& result)
                s.cue_reconciled_blocks,
                s.surface_vote_turned,
                s.sensor_turned,
+               s.frame_sensors,
+               s.frame_turned,
                s.scan_kind == DACPO_SCAN_SINGLE_VIEW ? "single" : "multi",
                s.single_view_fit,
                s.dipole_c_used,

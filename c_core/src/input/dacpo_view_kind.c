@@ -35,6 +35,7 @@
  */
 #include "dacpo_view_kind.h"
 
+#include "dacpo_kdtree.h"
 #include "dacpo_rng.h"
 
 #include <math.h>
@@ -52,7 +53,7 @@ model_log_density(const dacpo_view_sample* s, size_t i, const double v[3])
   const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   const double* q = s->n + 3 * i;
   const double c = fabs(q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / sqrt(fmax(r2, 1e-300));
-  return log(fmax(c, 0.05)) - log(fmax(r2, 1e-300));
+  return log(fmax(c, 0.05) / fmax(r2, 1e-300)); /* one log: the fits call it most */
 }
 
 double
@@ -123,22 +124,11 @@ sensor_spread(const dacpo_view_sample* s, const double* logd, const double v[3])
  * the best-correlated candidate). */
 #define DACPO_SENSOR_SEARCH_EVALS 600
 
+/* Compass search from v (a candidate with the least spread). */
 static void
-place_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
+refine_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
 {
-  dacpo_rng rng; /* the same candidates as the fit's */
-  dacpo_view_rng_seed(&rng);
-  double least = HUGE_VAL;
-  for (size_t k = 0; k < DACPO_VIEW_KIND_CANDIDATES; ++k) {
-    double c[3];
-    dacpo_view_candidate(s, &rng, k, c);
-    const double spread = sensor_spread(s, logd, c);
-    if (spread < least) {
-      least = spread;
-      memcpy(v, c, sizeof(c));
-    }
-  }
-  double cur = least;
+  double cur = sensor_spread(s, logd, v);
   double h = s->diam / 8.0;
   for (size_t evals = 0; h > 1e-4 * s->diam && evals < DACPO_SENSOR_SEARCH_EVALS;) {
     int moved = 0;
@@ -157,6 +147,24 @@ place_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
     if (!moved)
       h *= 0.5;
   }
+}
+
+static void
+place_sensor(const dacpo_view_sample* s, const double* logd, double v[3])
+{
+  dacpo_rng rng; /* the same candidates as the fit's */
+  dacpo_view_rng_seed(&rng);
+  double least = HUGE_VAL;
+  for (size_t k = 0; k < DACPO_VIEW_KIND_CANDIDATES; ++k) {
+    double c[3];
+    dacpo_view_candidate(s, &rng, k, c);
+    const double spread = sensor_spread(s, logd, c);
+    if (spread < least) {
+      least = spread;
+      memcpy(v, c, sizeof(c));
+    }
+  }
+  refine_sensor(s, logd, v);
 }
 
 dacpo_status
@@ -216,6 +224,178 @@ dacpo_single_view_sensor(const double* xyz,
   if (sensor && best >= DACPO_SENSOR_FIT)
     place_sensor(&vs, logd, sensor);
   free(logd);
+  dacpo_view_sample_free(&vs);
+  return DACPO_OK;
+}
+
+/* ---- One window of consecutive points ------------------------------------
+ *
+ * Why: registered depth frames concatenated into one cloud keep their points
+ * frame by frame. In the whole cloud the frames' densities add up and no one
+ * sensor explains them, but a window of consecutive points, its densities
+ * taken among its own points only, is one frame (or a part of one) again.
+ * Where the frame sees more than one plane, the densities also say on which
+ * side of the surfaces the sensor stands: from a candidate behind them the
+ * near surfaces are the far ones, so its fit falls under
+ * DACPO_SINGLE_VIEW_FIT (or its slope under DACPO_SINGLE_VIEW_SLOPE). A
+ * window whose fit reaches DACPO_SENSOR_FIT while no candidate on the other
+ * side reaches DACPO_SINGLE_VIEW_FIT has a sensor with a side; a flat window
+ * fits its sensor's mirror image as well and has none. A window that holds
+ * the end of one frame and the start of the next is a mix: the sensor placed
+ * must explain each half of the window's sample (fit >= DACPO_SINGLE_VIEW_FIT)
+ * on its own (the sign pass asks the other tiling's window too). */
+enum {
+  WINDOW_SAMPLE = 512,
+  WINDOW_BASES = 64, /* sample points the candidates start from */
+  WINDOW_CANDIDATES = 8 * WINDOW_BASES,
+  WINDOW_MIN = 256, /* points: fewer give no density worth fitting */
+  WINDOW_K = 8      /* the k-th neighbour of the densities, as for the cloud */
+};
+
+/* Candidate k of a window: one of WINDOW_BASES evenly spread sample points
+ * pushed along its axis by 1/4, 1/2, 1 or 2 diameters, both ways, so that
+ * each side of every base point is searched alike (the other side's best fit
+ * decides whether the window has a side). */
+static void
+window_candidate(const dacpo_view_sample* s, size_t k, double v[3])
+{
+  static const double push[4] = {0.25, 0.5, 1.0, 2.0};
+  const size_t base = (k / 8) * s->m / WINDOW_BASES;
+  const double t = (k & 4u ? -1.0 : 1.0) * push[k % 4] * s->diam;
+  for (int d = 0; d < 3; ++d)
+    v[d] = s->p[3 * base + d] + t * s->n[3 * base + d];
+}
+
+/* -2 log r_k of each sample point, r_k its WINDOW_K-th neighbour among the
+ * window's m points (distinct points: the nearest is the point itself). */
+static double*
+window_log_density(const double* xyz,
+                   size_t m,
+                   const dacpo_view_sample* vs,
+                   dacpo_err* err)
+{
+  dacpo_kdtree* tree = NULL;
+  double* logd = dacpo_malloc_array(vs->m ? vs->m : 1, sizeof(double));
+  if (!logd || dacpo_kdtree_build(xyz, m, &tree, err) != DACPO_OK) {
+    free(logd);
+    return NULL;
+  }
+  for (size_t i = 0; i < vs->m; ++i) {
+    int32_t idx[WINDOW_K + 1];
+    double d2[WINDOW_K + 1];
+    const size_t got = dacpo_kdtree_knn(tree, vs->p + 3 * i, WINDOW_K + 1, idx, d2);
+    logd[i] = -log(fmax(d2[got - 1], 1e-300));
+  }
+  dacpo_kdtree_free(tree);
+  return logd;
+}
+
+/* 1 if most sample points see a and b from the same side of their plane. */
+static int
+same_side(const dacpo_view_sample* s, const double a[3], const double b[3])
+{
+  size_t same = 0;
+  for (size_t i = 0; i < s->m; ++i) {
+    const double* p = s->p + 3 * i;
+    const double* q = s->n + 3 * i;
+    const double fa =
+        q[0] * (a[0] - p[0]) + q[1] * (a[1] - p[1]) + q[2] * (a[2] - p[2]);
+    const double fb =
+        q[0] * (b[0] - p[0]) + q[1] * (b[1] - p[1]) + q[2] * (b[2] - p[2]);
+    same += (fa > 0.0) == (fb > 0.0);
+  }
+  return 2 * same >= s->m;
+}
+
+/* The best-fitting candidate (slope >= DACPO_SINGLE_VIEW_SLOPE) when it
+ * reaches DACPO_SENSOR_FIT and no candidate seen from the other side reaches
+ * DACPO_SINGLE_VIEW_FIT: 1, *best set and *start the candidate on its side
+ * with the least spread; else 0. fit, cand: scratch for WINDOW_CANDIDATES. */
+static int
+window_sided_fit(const dacpo_view_sample* s,
+                 const double* logd,
+                 double* fit,
+                 double* cand,
+                 double best[3],
+                 double start[3])
+{
+  size_t top = 0;
+  for (size_t k = 0; k < WINDOW_CANDIDATES; ++k) {
+    window_candidate(s, k, cand + 3 * k);
+    double slope = 0.0;
+    fit[k] = dacpo_view_density_fit(s, logd, cand + 3 * k, &slope);
+    if (slope < DACPO_SINGLE_VIEW_SLOPE)
+      fit[k] = -1.0;
+    if (fit[k] > fit[top])
+      top = k;
+  }
+  if (fit[top] < DACPO_SENSOR_FIT)
+    return 0;
+  double least = HUGE_VAL;
+  for (size_t k = 0; k < WINDOW_CANDIDATES; ++k) {
+    const int same = same_side(s, cand + 3 * top, cand + 3 * k);
+    if (!same && fit[k] >= DACPO_SINGLE_VIEW_FIT)
+      return 0;
+    const double spread = same ? sensor_spread(s, logd, cand + 3 * k) : HUGE_VAL;
+    if (spread < least) {
+      least = spread;
+      memcpy(start, cand + 3 * k, 3 * sizeof(double));
+    }
+  }
+  memcpy(best, cand + 3 * top, 3 * sizeof(double));
+  return 1;
+}
+
+/* Each half of the sample on its own fits the sensor at v. */
+static int
+halves_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
+{
+  const size_t h = s->m / 2;
+  dacpo_view_sample half = *s;
+  half.m = h;
+  if (dacpo_view_density_fit(&half, logd, v, NULL) < DACPO_SINGLE_VIEW_FIT)
+    return 0;
+  half.p = s->p + 3 * h;
+  half.n = s->n + 3 * h;
+  half.m = s->m - h;
+  return dacpo_view_density_fit(&half, logd + h, v, NULL) >= DACPO_SINGLE_VIEW_FIT;
+}
+
+dacpo_status
+dacpo_window_sensor(const double* xyz,
+                    const double* axes,
+                    size_t m,
+                    int* found,
+                    double sensor[3],
+                    dacpo_err* err)
+{
+  DACPO_CHECK(err,
+              xyz && axes && found && sensor,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "window sensor: NULL argument");
+  *found = 0;
+  if (m < WINDOW_MIN)
+    return DACPO_OK;
+  dacpo_view_sample vs;
+  DACPO_TRY(
+      dacpo_view_sample_take_at_most(xyz, axes, NULL, m, WINDOW_SAMPLE, &vs, err));
+  double* fit = dacpo_malloc_array(WINDOW_CANDIDATES, sizeof(double));
+  double* cand = dacpo_malloc_array(3 * WINDOW_CANDIDATES, sizeof(double));
+  double* logd = fit && cand ? window_log_density(xyz, m, &vs, err) : NULL;
+  if (!logd) {
+    free(fit);
+    free(cand);
+    dacpo_view_sample_free(&vs);
+    return DACPO_OOM(err);
+  }
+  double best[3];
+  if (window_sided_fit(&vs, logd, fit, cand, best, sensor)) {
+    refine_sensor(&vs, logd, sensor);
+    *found = same_side(&vs, best, sensor) && halves_fit(&vs, logd, sensor);
+  }
+  free(logd);
+  free(fit);
+  free(cand);
   dacpo_view_sample_free(&vs);
   return DACPO_OK;
 }

@@ -52,6 +52,23 @@ dacpo_single_view_sensor(const double* xyz,
                          double sensor[3],
                          dacpo_err* err);
 
+/* The sensor of one window of consecutive points of a cloud (xyz, axes: m
+ * points and unit axes, 3m each), as registered depth frames concatenated
+ * keep them: *found = 1 and sensor set when the window's own densities (its
+ * 8th neighbours among its m points) place one sensor (fit >=
+ * DACPO_SENSOR_FIT, each half of the window explained on its own) and say on
+ * which side of the surfaces it stands (no candidate seen from the other side
+ * fits >= DACPO_SINGLE_VIEW_FIT); else *found = 0 (a flat window, a window of
+ * many views or of uniform density, fewer than 256 points). Deterministic.
+ * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
+dacpo_status
+dacpo_window_sensor(const double* xyz,
+                    const double* axes,
+                    size_t m,
+                    int* found,
+                    double sensor[3],
+                    dacpo_err* err);
+
 /* The fit from which a cloud counts as one depth view (the global sign uses the
  * same threshold to single out a sensor). */
 #define DACPO_SINGLE_VIEW_FIT 0.5

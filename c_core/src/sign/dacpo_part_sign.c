@@ -216,17 +216,32 @@ dacpo_view_sample_take(const double* xyz,
                        dacpo_view_sample* s,
                        dacpo_err* err)
 {
+  return dacpo_view_sample_take_at_most(xyz, nrm, part, n, DACPO_VIEW_SAMPLE, s, err);
+}
+
+dacpo_status
+dacpo_view_sample_take_at_most(const double* xyz,
+                               const double* nrm,
+                               const int32_t* part,
+                               size_t n,
+                               size_t max_m,
+                               dacpo_view_sample* s,
+                               dacpo_err* err)
+{
   memset(s, 0, sizeof(*s));
-  s->p = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
-  s->n = dacpo_malloc_array(3 * DACPO_VIEW_SAMPLE, sizeof(double));
-  s->part = dacpo_malloc_array(DACPO_VIEW_SAMPLE, sizeof(int32_t));
+  DACPO_CHECK(err,
+              max_m >= 1 && max_m <= DACPO_VIEW_SAMPLE,
+              DACPO_ERR_INVALID_ARGUMENT,
+              "view sample: size out of range");
+  s->p = dacpo_malloc_array(3 * max_m, sizeof(double));
+  s->n = dacpo_malloc_array(3 * max_m, sizeof(double));
+  s->part = dacpo_malloc_array(max_m, sizeof(int32_t));
   if (!s->p || !s->n || !s->part) {
     dacpo_view_sample_free(s);
     return DACPO_OOM(err);
   }
   /* Evenly strided sample of the whole cloud and its bounding box. */
-  const size_t stride =
-      n > DACPO_VIEW_SAMPLE ? (n + DACPO_VIEW_SAMPLE - 1) / DACPO_VIEW_SAMPLE : 1;
+  const size_t stride = n > max_m ? (n + max_m - 1) / max_m : 1;
   s->stride = stride;
   for (int d = 0; d < 3; ++d) {
     s->lo[d] = HUGE_VAL;
@@ -237,7 +252,7 @@ dacpo_view_sample_take(const double* xyz,
       s->lo[d] = fmin(s->lo[d], xyz[3 * i + d]);
       s->hi[d] = fmax(s->hi[d], xyz[3 * i + d]);
     }
-    if (i % stride == 0 && s->m < DACPO_VIEW_SAMPLE) {
+    if (i % stride == 0 && s->m < max_m) {
       memcpy(s->p + 3 * s->m, xyz + 3 * i, 3 * sizeof(double));
       memcpy(s->n + 3 * s->m, nrm + 3 * i, 3 * sizeof(double));
       s->part[s->m++] = part ? part[i] : 0;

@@ -54,6 +54,16 @@ dacpo_view_sample_take(const double* xyz,
                        dacpo_view_sample* s,
                        dacpo_err* err);
 
+/* The same with at most max_m points (1 <= max_m <= DACPO_VIEW_SAMPLE). */
+dacpo_status
+dacpo_view_sample_take_at_most(const double* xyz,
+                               const double* nrm,
+                               const int32_t* part,
+                               size_t n,
+                               size_t max_m,
+                               dacpo_view_sample* s,
+                               dacpo_err* err);
+
 void
 dacpo_view_sample_free(dacpo_view_sample* s);
 

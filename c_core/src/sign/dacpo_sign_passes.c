@@ -23,17 +23,22 @@
  *   8 surface vote     per-point turns: large smooth surfaces keep one
  *                      orientation
  *   9 sensor           per-point turns: in one depth view, every point its
- *                      sensor sees squarely faces it (the last word)
+ *                      sensor sees squarely faces it
+ *  10 frame sensors    per-point turns: where the points come frame by frame,
+ *                      every point its frame's sensor sees squarely faces it
+ *                      (the last word)
  */
+#include "dacpo_sign_passes.h"
+
 #include <dacpo/dacpo_advanced.h>
 
 #include "dacpo_block_graph.h"
 #include "dacpo_context.h"
+#include "dacpo_frame_sensors.h"
 #include "dacpo_global_sign.h"
 #include "dacpo_ilp.h"
 #include "dacpo_job_internal.h"
 #include "dacpo_part_sign.h"
-#include "dacpo_sign_passes.h"
 #include "dacpo_surface_vote.h"
 
 #include <math.h>
@@ -779,14 +784,14 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
 #define DACPO_SENSOR_MAX_AWAY 0.25
 
 /* +1 / -1: point i's output normal (its axis, signed as the run signs it now)
- * faces the sensor squarely / faces away squarely; 0: seen near grazing. */
+ * faces the sensor at v squarely / faces away squarely; 0: seen near grazing. */
 static int
-sensor_side(const run_state* s, size_t i)
+sensor_side(const run_state* s, size_t i, const double v[3])
 {
   const double* p = s->cloud.xyz + 3 * i;
   const double* a = s->cloud.nrm + 3 * i;
   const double* o = s->oriented + 3 * i;
-  const double r[3] = {s->sensor[0] - p[0], s->sensor[1] - p[1], s->sensor[2] - p[2]};
+  const double r[3] = {v[0] - p[0], v[1] - p[1], v[2] - p[2]};
   const double along = a[0] * o[0] + a[1] * o[1] + a[2] * o[2] >= 0.0 ? 1.0 : -1.0;
   const double dot = along * dacpo_sign_point(s, i) * (a[0] * r[0] + a[1] * r[1] + a[2] * r[2]);
   const double len =
@@ -803,7 +808,7 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
     return DACPO_OK;
   size_t facing = 0, away = 0;
   for (size_t i = 0; i < n; ++i) {
-    const int side = sensor_side(s, i);
+    const int side = sensor_side(s, i, s->sensor);
     facing += side > 0;
     away += side < 0;
   }
@@ -815,10 +820,53 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
   if (!s->turned && !(s->turned = dacpo_calloc_array(n ? n : 1, sizeof(uint8_t))))
     return DACPO_OOM(err);
   for (size_t i = 0; i < n; ++i)
-    if (sensor_side(s, i) < 0) {
+    if (sensor_side(s, i, s->sensor) < 0) {
       s->turned[i] = (uint8_t)!s->turned[i];
       ++st->sensor_turned;
     }
+  return DACPO_OK;
+}
+
+/* The frames' sensors (dacpo_frame_sensors.c), where the points come frame
+ * by frame: a point turns to face them when both windows holding it found a
+ * sensor and it faces away squarely from both. One window alone does not
+ * turn it: a window that mixes the end of one frame with the start of the
+ * next places one sensor for both, and a cloud sampled surface by surface
+ * (a mesh's faces, a generated scene's patches) can hold whole surfaces and
+ * a part of the next, whose density steps a far sensor explains; the other
+ * tiling's window holds other parts. */
+static dacpo_status
+face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
+{
+  const size_t n = s->cloud.n;
+  st->frame_sensors = 0;
+  st->frame_turned = 0;
+  if (s->p.sign_policy != DACPO_SIGN_FREE_SPACE || n == 0)
+    return DACPO_OK;
+  dacpo_frame_windows w;
+  DACPO_TRY(dacpo_frame_windows_find(
+      s->cloud.xyz, s->cloud.nrm, n, s->p.num_threads, &w, err));
+  uint8_t* away =
+      dacpo_calloc_array(n, sizeof(uint8_t)); /* found windows saying turn */
+  if (!away || (!s->turned && !(s->turned = dacpo_calloc_array(n, sizeof(uint8_t))))) {
+    free(away);
+    dacpo_frame_windows_free(&w);
+    return DACPO_OOM(err);
+  }
+  for (size_t k = 0; k < w.count; ++k) {
+    if (!w.found[k])
+      continue;
+    ++st->frame_sensors;
+    for (size_t i = w.first[k]; i < w.end[k]; ++i)
+      away[i] += sensor_side(s, i, w.sensor + 3 * k) < 0;
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (away[i] == 2) {
+      s->turned[i] = (uint8_t)!s->turned[i];
+      ++st->frame_turned;
+    }
+  free(away);
+  dacpo_frame_windows_free(&w);
   return DACPO_OK;
 }
 
@@ -837,5 +885,6 @@ dacpo_sign_passes(run_state* s, dacpo_stats* st, dacpo_err* err)
     DACPO_TRY(parts_follow_the_cue(s, st->num_parts, &st->parts_cue_signed, err));
   DACPO_TRY(reconcile_cue_with_free_space(s, &st->cue_reconciled_blocks, err));
   DACPO_TRY(surface_vote(s, st, err));
-  return face_the_sensor(s, st, err);
+  DACPO_TRY(face_the_sensor(s, st, err));
+  return face_the_frame_sensors(s, st, err);
 }

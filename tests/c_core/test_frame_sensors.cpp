@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The frames' sensors (sign/dacpo_frame_sensors.c, dacpo_window_sensor in
+// input/dacpo_view_kind.c) with known answers: a generated room seen by a few
+// depth cameras, its points view by view as registered frames concatenated.
+// Each window of consecutive points whose densities place a sensor places it
+// on its camera's side (every squarely seen ground-truth normal faces it);
+// the same points in a shuffled order, or a room sampled uniformly, give no
+// window a sensor. Then the pipeline: a three-camera room whose second
+// camera's walls the viewpoint vote turned inside out comes out right.
+#include <dacpo/dacpo.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <vector>
+
+extern "C" {
+#include "dacpo_frame_sensors.h"
+#include "dacpo_scene.h"
+#include "dacpo_score.h"
+}
+#include "scene_fixture.hpp"
+
+namespace {
+
+struct CameraRoom {
+  dacpo_scene s{};
+  dacpo_scene_view_info info{};
+  bool ok = false;
+  CameraRoom(size_t n, unsigned views, double shift, double angle, uint64_t seed)
+  {
+    dacpo_scene_params p;
+    dacpo_scene_params_init(&p);
+    p.kind = DACPO_SCENE_ROOM;
+    p.target_points = n;
+    p.seed = seed;
+    p.views = views;
+    p.view_shift = shift;
+    p.view_angle = angle;
+    char err[256] = "";
+    ok = dacpo_scene_generate_views(&p, &s, &info, err, sizeof(err)) == 0;
+    EXPECT_TRUE(ok) << err;
+  }
+  ~CameraRoom() { dacpo_scene_free(&s); }
+  CameraRoom(const CameraRoom&) = delete;
+  CameraRoom&
+  operator=(const CameraRoom&) = delete;
+};
+
+struct Windows {
+  dacpo_frame_windows w{};
+  size_t found = 0;
+  Windows(const std::vector<double>& xyz, const std::vector<double>& axes)
+  {
+    dacpo_err err{};
+    EXPECT_EQ(
+        dacpo_frame_windows_find(xyz.data(), axes.data(), xyz.size() / 3, 2, &w, &err),
+        DACPO_OK)
+        << err.msg;
+    for (size_t k = 0; k < w.count; ++k)
+      found += w.found[k];
+  }
+  ~Windows() { dacpo_frame_windows_free(&w); }
+  Windows(const Windows&) = delete;
+  Windows&
+  operator=(const Windows&) = delete;
+};
+
+// Of window k's points that its sensor sees within 60 degrees of their
+// ground-truth normal's axis, those whose normal faces away, and all of them.
+void
+squarelySeen(const Windows& win,
+             size_t k,
+             const float* xyz,
+             const float* gt,
+             size_t* away,
+             size_t* all)
+{
+  const double* v = win.w.sensor + 3 * k;
+  *away = *all = 0;
+  for (size_t i = win.w.first[k]; i < win.w.end[k]; ++i) {
+    double r[3], rr = 0.0, dot = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      r[c] = v[c] - xyz[3 * i + c];
+      rr += r[c] * r[c];
+      dot += r[c] * gt[3 * i + c];
+    }
+    if (std::fabs(dot) < 0.5 * std::sqrt(rr))
+      continue;
+    ++*all;
+    *away += dot < 0.0;
+  }
+}
+
+// Orients n points with estimated normals and run seed 1; the run's stats.
+dacpo_stats
+orientDefault(const float* xyz, size_t n, std::vector<float>* nrm)
+{
+  nrm->assign(3 * n, 0.0f);
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.estimate_normals = 1;
+  p.seed = 1;
+  dacpo_ctx* ctx = nullptr;
+  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+  EXPECT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, xyz, nrm->data(), n), DACPO_OK)
+      << dacpo_ctx_last_error(ctx);
+  const dacpo_stats st = *dacpo_ctx_stats(ctx);
+  dacpo_ctx_free(ctx);
+  return st;
+}
+
+} // namespace
+
+// Three and five cameras, 5 mm / 0.1 degrees of pose error (scene seed 2):
+// every found window inside one camera's points has its sensor on that
+// camera's side. A window holding the end of one camera's points and the
+// start of the next may not (the sign pass asks the other tiling's window
+// too). Measured: 0 of the squarely seen points face away in every found
+// window (27 and 18 of 31 windows found, 25 and 15 of them inside one view).
+TEST(DacpoFrameSensors, EachFoundWindowStandsOnItsCamerasSide)
+{
+  for (unsigned views : {3u, 5u}) {
+    CameraRoom room(60000, views, 0.005, 0.1, 2);
+    ASSERT_TRUE(room.ok);
+    const size_t n = room.s.n;
+    std::vector<double> xyz(room.s.xyz, room.s.xyz + 3 * n);
+    std::vector<double> axes(room.s.normals, room.s.normals + 3 * n);
+    Windows win(xyz, axes);
+    size_t away_all = 0, seen_all = 0, inside = 0;
+    for (size_t k = 0; k < win.w.count; ++k) {
+      if (!win.w.found[k])
+        continue;
+      bool one_view = false;
+      for (unsigned v = 0; v < room.info.views; ++v)
+        one_view = one_view || (win.w.first[k] >= room.info.view_start[v] &&
+                                win.w.end[k] <= room.info.view_start[v + 1]);
+      if (!one_view)
+        continue;
+      ++inside;
+      size_t away = 0, all = 0;
+      squarelySeen(win, k, room.s.xyz, room.s.normals, &away, &all);
+      EXPECT_LE(away, all / 100) << views << " views, window " << k;
+      away_all += away;
+      seen_all += all;
+    }
+    printf("%u views: %zu of %zu windows found, %zu inside one view; %zu of their %zu "
+           "squarely seen points face away\n",
+           views,
+           win.found,
+           win.w.count,
+           inside,
+           away_all,
+           seen_all);
+    EXPECT_GE(inside, win.w.count / 4) << views << " views";
+  }
+}
+
+// The order is what finds the frames: the same points shuffled, and a room
+// sampled uniformly, give no window a sensor.
+TEST(DacpoFrameSensors, ShuffledPointsOrUniformSamplingFindNone)
+{
+  CameraRoom room(60000, 3, 0.005, 0.1, 2);
+  ASSERT_TRUE(room.ok);
+  const size_t n = room.s.n;
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(7));
+  std::vector<double> xyz(3 * n), axes(3 * n);
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      xyz[3 * i + c] = room.s.xyz[3 * order[i] + c];
+      axes[3 * i + c] = room.s.normals[3 * order[i] + c];
+    }
+  Windows shuffled(xyz, axes);
+  EXPECT_EQ(shuffled.found, 0u);
+
+  GeneratedScene uniform(DACPO_SCENE_ROOM, 60000, 2);
+  ASSERT_TRUE(uniform.ok);
+  std::vector<double> uxyz(uniform.s.xyz, uniform.s.xyz + 3 * uniform.s.n);
+  std::vector<double> uaxes(uniform.s.normals, uniform.s.normals + 3 * uniform.s.n);
+  Windows even(uxyz, uaxes);
+  EXPECT_EQ(even.found, 0u);
+}
+
+// Three cameras, 5 mm / 0.1 degrees (scene seed 2, 100K points): the parts'
+// viewpoint, placed to explain the first camera's walls, turned the second
+// camera's inside out (34.02 % wrong before the frames' sensors, run seed 1).
+// Each frame's sensor turns its walls back. Measured: 2.71 % wrong, 97.29 %
+// with the right sign as given (32 windows found, 31,312 points turned).
+TEST(DacpoFrameSensors, EachCamerasWallsFaceItsCamera)
+{
+  CameraRoom room(100000, 3, 0.005, 0.1, 2);
+  ASSERT_TRUE(room.ok);
+  const size_t n = room.s.n;
+  std::vector<float> nrm;
+  const dacpo_stats st = orientDefault(room.s.xyz, n, &nrm);
+  const double wrong =
+      dacpo_score_oriented(room.s.normals, nrm.data(), n, nullptr, nullptr);
+  size_t right_sign = 0;
+  for (size_t i = 0; i < n; ++i)
+    right_sign += room.s.normals[3 * i] * nrm[3 * i] +
+                      room.s.normals[3 * i + 1] * nrm[3 * i + 1] +
+                      room.s.normals[3 * i + 2] * nrm[3 * i + 2] >
+                  0.0f;
+  printf(
+      "three cameras: %.2f %% wrong, %.2f %% with the right sign as given; %zu frame "
+      "sensors, %zu points turned\n",
+      wrong,
+      100.0 * (double)right_sign / (double)n,
+      st.frame_sensors,
+      st.frame_turned);
+  EXPECT_GT(st.frame_sensors, 0u);
+  EXPECT_LE(wrong, 6.0);
+  EXPECT_GE((double)right_sign, 0.94 * (double)n);
+}
+
+// A cloud sampled surface by surface (a generated room, its patches one after
+// another at one density, as a mesh's faces sampled in order) has no frames.
+// A window holding a whole wall and part of the next shows density steps
+// that a sensor far outside the room explains (fit 0.80, slope 0.99: one
+// window of this room, scene seed 1, 20K points); turned on one window's
+// word it made the room 4.28 -> 16.30 % wrong. Both windows holding a point
+// must find a sensor: nothing turns.
+TEST(DacpoFrameSensors, ASurfaceBySurfaceSampleTurnsNothing)
+{
+  GeneratedScene room(DACPO_SCENE_ROOM, 20000, 1);
+  ASSERT_TRUE(room.ok);
+  std::vector<float> nrm;
+  const dacpo_stats st = orientDefault(room.s.xyz, room.s.n, &nrm);
+  const double wrong =
+      dacpo_score_oriented(room.s.normals, nrm.data(), room.s.n, nullptr, nullptr);
+  printf("surface by surface: %zu frame sensors, %zu points turned, %.2f %% wrong\n",
+         st.frame_sensors,
+         st.frame_turned,
+         wrong);
+  EXPECT_EQ(st.frame_turned, 0u);
+  EXPECT_LT(wrong, 6.0);
+}
