@@ -335,7 +335,10 @@ typedef struct dacpo_stats {
   size_t frame_turned;        /**< distinct points turned to face their frame's
                                    sensor, the last sign pass: both windows
                                    holding the point found one and see it within
-                                   60 degrees of its normal, facing away */
+                                   60 degrees of its normal, facing away; or
+                                   its block turned whole, where at least 5 %
+                                   of its points say so and under a quarter
+                                   as many say the opposite */
 } dacpo_stats;
 
 /** \brief Diagnostics of one block-graph edge. */

@@ -828,13 +828,53 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
 }
 
 /* The frames' sensors (dacpo_frame_sensors.c), where the points come frame
- * by frame: a point turns to face them when both windows holding it found a
- * sensor and it faces away squarely from both. One window alone does not
- * turn it: a window that mixes the end of one frame with the start of the
- * next places one sensor for both, and a cloud sampled surface by surface
- * (a mesh's faces, a generated scene's patches) can hold whole surfaces and
- * a part of the next, whose density steps a far sensor explains; the other
- * tiling's window holds other parts. */
+ * by frame. A point's word: both windows holding it found a sensor and it
+ * faces both the same way squarely. One window alone says nothing: a window
+ * that mixes the end of one frame with the start of the next places one
+ * sensor for both, and a cloud sampled surface by surface (a mesh's faces, a
+ * generated scene's patches) can hold whole surfaces and a part of the next,
+ * whose density steps a far sensor explains; the other tiling's window holds
+ * other parts. First whole blocks (what stage 2 made consistent) turn where
+ * their points' word is decisive: facing away from at least
+ * DACPO_FRAME_BLOCK_SHARE of the block, facing under DACPO_SENSOR_MAX_AWAY of
+ * that (a flat or grazing frame finds no sensor, so most of a block can go
+ * unseen by the pass); then every point its word says faces away turns. */
+#define DACPO_FRAME_BLOCK_SHARE 0.05
+
+/* vote[i] in -2..2: the sum of sensor_side over the found windows holding
+ * point i (-2 / +2: both found, both away / both facing). */
+static void
+frame_votes(const run_state* s,
+            const dacpo_frame_windows* w,
+            int8_t* vote,
+            dacpo_stats* st)
+{
+  for (size_t k = 0; k < w->count; ++k) {
+    if (!w->found[k])
+      continue;
+    ++st->frame_sensors;
+    for (size_t i = w->first[k]; i < w->end[k]; ++i)
+      vote[i] = (int8_t)(vote[i] + sensor_side(s, i, w->sensor + 3 * k));
+  }
+}
+
+/* turn[b] = 1 where block b's points' word is decisive (above). */
+static void
+frame_blocks(const run_state* s, const int8_t* vote, uint8_t* turn)
+{
+  const dacpo_blocks* bl = &s->blocks;
+  for (size_t b = 0; b < bl->num_blocks; ++b) {
+    size_t away = 0, facing = 0;
+    for (size_t j = bl->own_start[b]; j < bl->own_start[b + 1]; ++j) {
+      away += vote[bl->own[j]] == -2;
+      facing += vote[bl->own[j]] == 2;
+    }
+    const double size = (double)(bl->own_start[b + 1] - bl->own_start[b]);
+    turn[b] = (uint8_t)((double)away >= DACPO_FRAME_BLOCK_SHARE * size &&
+                        (double)facing < DACPO_SENSOR_MAX_AWAY * (double)away);
+  }
+}
+
 static dacpo_status
 face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
 {
@@ -846,28 +886,28 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
   dacpo_frame_windows w;
   DACPO_TRY(dacpo_frame_windows_find(
       s->cloud.xyz, s->cloud.nrm, n, s->p.num_threads, &w, err));
-  uint8_t* away =
-      dacpo_calloc_array(n, sizeof(uint8_t)); /* found windows saying turn */
-  if (!away || (!s->turned && !(s->turned = dacpo_calloc_array(n, sizeof(uint8_t))))) {
-    free(away);
-    dacpo_frame_windows_free(&w);
-    return DACPO_OOM(err);
+  int8_t* vote = dacpo_calloc_array(n, sizeof(int8_t));
+  uint8_t* turn_block = dacpo_calloc_array(s->blocks.num_blocks + 1, sizeof(uint8_t));
+  dacpo_status r = vote && turn_block ? DACPO_OK : DACPO_OOM(err);
+  if (r == DACPO_OK && !s->turned &&
+      !(s->turned = dacpo_calloc_array(n, sizeof(uint8_t))))
+    r = DACPO_OOM(err);
+  if (r == DACPO_OK) {
+    frame_votes(s, &w, vote, st);
+    frame_blocks(s, vote, turn_block);
   }
-  for (size_t k = 0; k < w.count; ++k) {
-    if (!w.found[k])
-      continue;
-    ++st->frame_sensors;
-    for (size_t i = w.first[k]; i < w.end[k]; ++i)
-      away[i] += sensor_side(s, i, w.sensor + 3 * k) < 0;
-  }
-  for (size_t i = 0; i < n; ++i)
-    if (away[i] == 2) {
+  for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
+    const int whole = turn_block[s->blocks.block_of[i]];
+    if (whole !=
+        (vote[i] == (whole ? 2 : -2))) { /* its block's turn, unless it said so */
       s->turned[i] = (uint8_t)!s->turned[i];
       ++st->frame_turned;
     }
-  free(away);
+  }
+  free(vote);
+  free(turn_block);
   dacpo_frame_windows_free(&w);
-  return DACPO_OK;
+  return r;
 }
 
 dacpo_status
