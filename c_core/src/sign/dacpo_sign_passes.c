@@ -897,9 +897,9 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
     frame_blocks(s, vote, turn_block);
   }
   for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
-    const int whole = turn_block[s->blocks.block_of[i]];
-    if (whole !=
-        (vote[i] == (whole ? 2 : -2))) { /* its block's turn, unless it said so */
+    /* its block's turn unless its own word is that it faces; else its word */
+    const int turn = turn_block[s->blocks.block_of[i]] ? vote[i] != 2 : vote[i] == -2;
+    if (turn) {
       s->turned[i] = (uint8_t)!s->turned[i];
       ++st->frame_turned;
     }
