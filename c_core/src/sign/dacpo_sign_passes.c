@@ -886,6 +886,13 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
   dacpo_frame_windows w;
   DACPO_TRY(dacpo_frame_windows_find(
       s->cloud.xyz, s->cloud.nrm, n, s->p.num_threads, &w, err));
+  size_t found = 0;
+  for (size_t k = 0; k < w.count; ++k)
+    found += w.found[k];
+  if (found == 0) { /* an order that says nothing: no pass, no buffers */
+    dacpo_frame_windows_free(&w);
+    return DACPO_OK;
+  }
   int8_t* vote = dacpo_calloc_array(n, sizeof(int8_t));
   uint8_t* turn_block = dacpo_calloc_array(s->blocks.num_blocks + 1, sizeof(uint8_t));
   dacpo_status r = vote && turn_block ? DACPO_OK : DACPO_OOM(err);
