@@ -99,24 +99,6 @@ const OptionSpec kOptions[] = {
      "(without normals in the input they are always estimated)",
      nullptr,
      setFlag<&Options::estimate>},
-    {"-vcr_perspective",
-     nullptr,
-     "perspective VCR projection (default: orthographic)",
-     nullptr,
-     [](Options& o, const std::string&, std::string&) {
-       o.params.vcr_perspective = 1;
-       return true;
-     },
-     true},
-    {"-vcr_c1c2",
-     nullptr,
-     "VCR score C1*C2 without the boundary factor C_B",
-     nullptr,
-     [](Options& o, const std::string&, std::string&) {
-       o.params.vcr_boundary_factor = 0;
-       return true;
-     },
-     true},
     {"-mesh",
      "F.ply",
      "also write the reconstructed surface (one mesh over\n"

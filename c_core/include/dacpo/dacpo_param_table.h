@@ -84,10 +84,6 @@
               "VCR image side in pixels (paper: 400)") \
   DACPO_PARAM(SIZE, size_t, vcr_views, 12, 1, 256, EXPERT, VALUE, "-vcr_views", \
               "VCR views around each block pair (12: dodecahedron face centres)") \
-  DACPO_PARAM(FLAG, int, vcr_perspective, 0, 0, 1, EXPERT, SPECIAL, "-vcr_perspective", \
-              "perspective instead of orthographic VCR projection") \
-  DACPO_PARAM(FLAG, int, vcr_boundary_factor, 1, 0, 1, EXPERT, SPECIAL, "-vcr_c1c2", \
-              "VCR score C_B C1 C2 (paper); 0 = C1 C2") \
   /* independent runs of stage 2 per block (M orders each, voted point by point), \
    * 1..64 (16); they stop after 4 that all agree */ \
   DACPO_PARAM(SIZE, size_t, dipole_restarts, 16, 1, 64, EXPERT, VALUE, "-restarts", \

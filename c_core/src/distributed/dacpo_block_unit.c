@@ -181,8 +181,6 @@ dacpo_block_unit_vcr_params(const dacpo_params* p, dacpo_vcr_params* vp)
   dacpo_vcr_params_default(vp);
   vp->image_size = p->vcr_image_size;
   vp->num_views = p->vcr_views;
-  vp->perspective = p->vcr_perspective != 0;
-  vp->boundary_factor = p->vcr_boundary_factor != 0;
 }
 
 /* ---- byte format --------------------------------------------------------- */

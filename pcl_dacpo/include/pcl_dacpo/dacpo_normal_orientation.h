@@ -505,32 +505,6 @@ public:
     return params_.vcr_views;
   }
 
-  /** \brief Perspective (true) or orthographic (false, default) VCR projection. */
-  void
-  setVCRPerspective(bool perspective)
-  {
-    params_.vcr_perspective = perspective ? 1 : 0;
-  }
-  /** \brief See setVCRPerspective(). */
-  bool
-  getVCRPerspective() const
-  {
-    return params_.vcr_perspective != 0;
-  }
-
-  /** \brief VCR score I = C_B*C1*C2 (true, default, paper) or C1*C2 (false). */
-  void
-  setVCRBoundaryFactor(bool use)
-  {
-    params_.vcr_boundary_factor = use ? 1 : 0;
-  }
-  /** \brief See setVCRBoundaryFactor(). */
-  bool
-  getVCRBoundaryFactor() const
-  {
-    return params_.vcr_boundary_factor != 0;
-  }
-
   /** \brief Keep the reconstructed surface: one mesh over all blocks, rebuilt from
    * the final normals and wound like them (default false); see getMesh(). */
   void

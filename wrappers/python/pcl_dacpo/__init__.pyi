@@ -45,8 +45,6 @@ def orient(
     disconnected: Union[str, int] = ...,
     vcr_image_size: int = ...,
     vcr_views: int = ...,
-    vcr_perspective: bool = ...,
-    vcr_boundary_factor: bool = ...,
     dipole_restarts: int = ...,
     weak_edge_fraction: float = ...,
     sign_policy: Union[str, int] = ...,
