@@ -844,15 +844,11 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
 /* vote[i] in -2..2: the sum of sensor_side over the found windows holding
  * point i (-2 / +2: both found, both away / both facing). */
 static void
-frame_votes(const run_state* s,
-            const dacpo_frame_windows* w,
-            int8_t* vote,
-            dacpo_stats* st)
+frame_votes(const run_state* s, const dacpo_frame_windows* w, int8_t* vote)
 {
   for (size_t k = 0; k < w->count; ++k) {
     if (!w->found[k])
       continue;
-    ++st->frame_sensors;
     for (size_t i = w->first[k]; i < w->end[k]; ++i)
       vote[i] = (int8_t)(vote[i] + sensor_side(s, i, w->sensor + 3 * k));
   }
@@ -886,10 +882,9 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
   dacpo_frame_windows w;
   DACPO_TRY(dacpo_frame_windows_find(
       s->cloud.xyz, s->cloud.nrm, n, s->p.num_threads, &w, err));
-  size_t found = 0;
   for (size_t k = 0; k < w.count; ++k)
-    found += w.found[k];
-  if (found == 0) { /* an order that says nothing: no pass, no buffers */
+    st->frame_sensors += w.found[k];
+  if (st->frame_sensors == 0) { /* an order that says nothing: no pass, no buffers */
     dacpo_frame_windows_free(&w);
     return DACPO_OK;
   }
@@ -900,7 +895,7 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
       !(s->turned = dacpo_calloc_array(n, sizeof(uint8_t))))
     r = DACPO_OOM(err);
   if (r == DACPO_OK) {
-    frame_votes(s, &w, vote, st);
+    frame_votes(s, &w, vote);
     frame_blocks(s, vote, turn_block);
   }
   for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
