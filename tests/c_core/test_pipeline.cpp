@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <random>
 #include <set>
 #include <string>
 #include <thread>
@@ -330,9 +331,30 @@ TEST(DacpoPipeline, SeedsOneToFiveAgreeOnAGeneratedRoom)
 // 3): 16.61 % wrong then, 4.83 % since groups join by the net evidence of
 // all their seams, 4.99 % since parts vote with cosines (CGAL's MST on the
 // same points: 4.48 %).
+// Each view's points (n / views each, the first n % views views one more)
+// in a random order of their own instead of row by row.
+void
+shuffleEachView(dacpo_scene* s, unsigned views)
+{
+  std::mt19937_64 rng(7);
+  for (size_t v = 0, first = 0; v < views; ++v) {
+    const size_t count = s->n / views + (v < s->n % views ? 1 : 0);
+    for (size_t j = count; j > 1; --j) {
+      const size_t a = first + j - 1, b = first + rng() % j;
+      for (int c = 0; c < 3; ++c) {
+        std::swap(s->xyz[3 * a + c], s->xyz[3 * b + c]);
+        std::swap(s->normals[3 * a + c], s->normals[3 * b + c]);
+      }
+      std::swap(s->part[a], s->part[b]);
+    }
+    first += count;
+  }
+}
+
 // The generated room seen by `views` depth cameras (pose error per view:
 // shift metres, angle degrees; none by default), oriented from estimated
-// normals: the run's stats and its % wrong.
+// normals: the run's stats and its % wrong. shuffled: each view's points in
+// a random order of their own.
 void
 orientViewedRoom(uint64_t scene_seed,
                  uint64_t run_seed,
@@ -340,7 +362,8 @@ orientViewedRoom(uint64_t scene_seed,
                  double* wrong,
                  double shift = 0.0,
                  double angle = 0.0,
-                 unsigned views = 20)
+                 unsigned views = 20,
+                 bool shuffled = false)
 {
   dacpo_scene_params sp = Scene::params(DACPO_SCENE_ROOM, 100000, scene_seed);
   sp.views = views;
@@ -348,6 +371,8 @@ orientViewedRoom(uint64_t scene_seed,
   sp.view_angle = angle;
   Scene sc(sp);
   ASSERT_TRUE(sc.ok);
+  if (shuffled)
+    shuffleEachView(&sc.s, views);
   dacpo_params p = defaults();
   p.estimate_normals = 1;
   p.seed = run_seed;
@@ -387,17 +412,21 @@ TEST(DacpoPipeline, ManyViewsThatPassForOneKeepTheirSigns)
   EXPECT_LT(wrong, 10.0);
 }
 
-// Five depth cameras 5 mm / 0.1 degrees apart (scene seed 1): the density
-// fits one of them well enough (0.77) for the last sign pass, but the
-// position it finds is that camera's mirror image outside the room: of the
-// points it sees squarely 20,097 face away and 36,320 face it (real depth
-// frames: at most one away in nineteen facing). Turning those took this room
-// from 0.10 to 20.01 % wrong (run seed 1); the pass must leave them.
+// Five depth cameras 5 mm / 0.1 degrees apart (scene seed 1, each view's
+// points shuffled): the density fits one of them well enough (0.77) for the
+// last sign pass, but the position it finds is that camera's mirror image
+// outside the room: of the points it sees squarely 20,097 face away and
+// 36,320 face it (real depth frames: at most one away in nineteen facing).
+// Turning those took this room from 0.10 to 20.01 % wrong (run seed 1); the
+// pass must leave them. (With the views row by row the parts' viewpoint
+// already turns the first camera's 20,000 points inside out, 20.01 %, and
+// none of that frame's windows finds a sensor: docs/DESIGN.md, known
+// limits.)
 TEST(DacpoPipeline, AFewFramesThatPassForOneKeepTheirSigns)
 {
   Result r;
   double wrong = 100.0;
-  ASSERT_NO_FATAL_FAILURE(orientViewedRoom(1, 1, &r, &wrong, 0.005, 0.1, 5));
+  ASSERT_NO_FATAL_FAILURE(orientViewedRoom(1, 1, &r, &wrong, 0.005, 0.1, 5, true));
   printf("five depth cameras, scene seed 1: %.2f %% wrong, fit %.3f, %zu turned\n",
          wrong,
          r.stats.single_view_fit,

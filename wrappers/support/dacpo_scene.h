@@ -113,8 +113,10 @@ typedef struct dacpo_scene_params {
                              concatenated): each of `views` cameras (60 x 45
                              degrees, 0.3..6 m) keeps only the surface it sees,
                              unoccluded, with a density falling as cos/r^2; the
-                             points come view by view, each view's share of
-                             target_points, and each view but the first is
+                             points come view by view, each view row by row
+                             (its image's rows top to bottom, each left to
+                             right, as a depth frame's pixels), each view's
+                             share of target_points, and each view but the first is
                              moved by its own pose error (below); normals face
                              their own camera; 0 = none (uniform sampling);
                              not with fused_views > 1; default 0 */

@@ -74,8 +74,8 @@ dacpo_scene_prim_sample(const scene_prim* p,
                         double nrm[3]);
 
 /* Depth-camera views (dacpo_scene_views.c): params->target_points points of
- * the patches of b, view by view, into s (xyz, normals, part; s->n set),
- * cameras into info. Returns 0, or -1 with a message when no camera place is
+ * the patches of b, view by view and each row by row, into s (xyz, normals, part; s->n
+ * set), cameras into info. Returns 0, or -1 with a message when no camera place is
  * found or a view sees too little. */
 int
 dacpo_scene_sample_views(const scene_builder* b,

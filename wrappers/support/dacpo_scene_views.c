@@ -9,7 +9,10 @@
  * ray-cylinder, ray-annulus and ray-sphere intersections: so a point is kept
  * only where the camera sees it unoccluded, with a surface density proportional
  * to cos(incidence) / range^2, exactly. The view's share of the points comes
- * out view by view; each view but the first is then moved by its pose error
+ * out view by view, each view row by row as a depth image's pixels (rows of
+ * an image with as many pixels as rays drawn, top to bottom, each left to
+ * right: registered frames concatenated keep that order, and the frames'
+ * sensors are found from it); each view but the first is then moved by its pose error
  * (a shift in a random direction, a turn about a random axis through the
  * camera). Ground-truth normal: the patch normal turned towards the point's
  * camera, turned with the pose error.
@@ -21,6 +24,7 @@
 #include "dacpo_support_err.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 enum { STREAM_VIEWS = 6 };
@@ -367,14 +371,76 @@ draw_ray(const view_cam* cam, dacpo_rng* r, double d[3])
     d[k] = lx * cam->right[k] + ly * cam->up[k] + lz * cam->fwd[k];
 }
 
-/* count points seen by cam into s from index first. Returns 0, or -1 when the
- * view sees too little. */
+typedef struct raster_key {
+  double u, v; /* image position, left to right and top to bottom, in [0, 1) */
+  double key;  /* row, then u within it */
+  size_t point;
+} raster_key;
+
+static int
+cmp_raster_key(const void* a, const void* b)
+{
+  const double x = ((const raster_key*)a)->key, y = ((const raster_key*)b)->key;
+  return (x > y) - (x < y);
+}
+
+/* The image position of ray d: u left to right, v top to bottom, in [0, 1). */
+static void
+image_position(const view_cam* cam, const double d[3], double* u, double* v)
+{
+  const double z = dot3(d, cam->fwd);
+  *u = fmin(fmax((dot3(d, cam->right) / z + VIEW_TAN_X) / (2.0 * VIEW_TAN_X), 0.0),
+            0.999999);
+  *v = fmin(fmax((VIEW_TAN_Y - dot3(d, cam->up) / z) / (2.0 * VIEW_TAN_Y), 0.0),
+            0.999999);
+}
+
+/* Points [first, first + count) of s put in raster order (a depth frame's
+ * pixels come row by row): an image of about `rays` pixels, as wide for its
+ * height as the field of view, its rows top to bottom, each left to right.
+ * Returns 0, or -1 out of memory. */
+static int
+raster_order(raster_key* keys, size_t count, size_t rays, size_t first, dacpo_scene* s)
+{
+  const double rows = fmax(1.0, floor(sqrt((double)rays * VIEW_TAN_Y / VIEW_TAN_X)));
+  for (size_t j = 0; j < count; ++j)
+    keys[j].key = floor(keys[j].v * rows) + keys[j].u;
+  float* xyz = malloc((count ? count : 1) * 6 * sizeof(float));
+  int32_t* part = malloc((count ? count : 1) * sizeof(int32_t));
+  if (!xyz || !part) {
+    free(xyz);
+    free(part);
+    return -1;
+  }
+  qsort(keys, count, sizeof(raster_key), cmp_raster_key);
+  for (size_t j = 0; j < count; ++j) {
+    const size_t i = first + keys[j].point;
+    memcpy(xyz + 6 * j, s->xyz + 3 * i, 3 * sizeof(float));
+    memcpy(xyz + 6 * j + 3, s->normals + 3 * i, 3 * sizeof(float));
+    part[j] = s->part[i];
+  }
+  for (size_t j = 0; j < count; ++j) {
+    memcpy(s->xyz + 3 * (first + j), xyz + 6 * j, 3 * sizeof(float));
+    memcpy(s->normals + 3 * (first + j), xyz + 6 * j + 3, 3 * sizeof(float));
+    s->part[first + j] = part[j];
+  }
+  free(xyz);
+  free(part);
+  return 0;
+}
+
+/* count points seen by cam into s from index first, in raster order. Returns
+ * 0, or -1 when the view sees too little (or out of memory). */
 static int
 sample_view(const scene_builder* b, const view_cam* cam, size_t count, size_t first, dacpo_rng* r, dacpo_scene* s)
 {
   const size_t max_rays = 400 * count + 100000;
+  raster_key* keys = malloc((count ? count : 1) * sizeof(raster_key));
+  if (!keys)
+    return -1;
   size_t got = 0;
-  for (size_t rays = 0; got < count && rays < max_rays; ++rays) {
+  size_t rays = 0;
+  for (; got < count && rays < max_rays; ++rays) {
     double d[3], x[3], n[3], t;
     draw_ray(cam, r, d);
     const int h = nearest_hit(b, cam->eye, d, VIEW_FAR, &t);
@@ -384,6 +450,8 @@ sample_view(const scene_builder* b, const view_cam* cam, size_t count, size_t fi
       x[k] = cam->eye[k] + t * d[k];
     prim_normal(&b->prims[h], x, n);
     const double flip = dot3(n, d) > 0.0 ? -1.0 : 1.0; /* towards the camera */
+    image_position(cam, d, &keys[got].u, &keys[got].v);
+    keys[got].point = got;
     const size_t i = first + got++;
     const double rel[3] = {x[0] - cam->eye[0], x[1] - cam->eye[1], x[2] - cam->eye[2]};
     for (int k = 0; k < 3; ++k) {
@@ -393,7 +461,9 @@ sample_view(const scene_builder* b, const view_cam* cam, size_t count, size_t fi
     }
     s->part[i] = (int32_t)h;
   }
-  return got == count ? 0 : -1;
+  const int ok = got == count && raster_order(keys, count, rays, first, s) == 0;
+  free(keys);
+  return ok ? 0 : -1;
 }
 
 int

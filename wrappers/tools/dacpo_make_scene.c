@@ -84,13 +84,16 @@ print_help(const char* prog)
          "                   by SHIFT metres and turned by DEG degrees (random\n"
          "                   directions), so surfaces come as offset copies, e.g.\n"
          "                   3,0.008,0.2 (default: none)\n");
-  printf("  -views V,SHIFT,DEG  V depth-camera views (60x45 deg, 0.3-6 m) like registered\n"
-         "                   RGB-D frames concatenated: each camera keeps the surface it\n"
-         "                   sees unoccluded (density ~ cos/range^2), view by view, each\n"
-         "                   view but the first moved by SHIFT metres and turned by DEG\n"
-         "                   degrees about its camera (random directions); normals face\n"
-         "                   their camera, e.g. 20,0.02,0.5 (V <= %d; default: none)\n",
-         DACPO_SCENE_MAX_VIEWS);
+  printf(
+      "  -views V,SHIFT,DEG  V depth-camera views (60x45 deg, 0.3-6 m) like "
+      "registered\n"
+      "                   RGB-D frames concatenated: each camera keeps the surface it\n"
+      "                   sees unoccluded (density ~ cos/range^2), view by view and\n"
+      "                   each view row by row as a depth image's pixels, each\n"
+      "                   view but the first moved by SHIFT metres and turned by DEG\n"
+      "                   degrees about its camera (random directions); normals face\n"
+      "                   their camera, e.g. 20,0.02,0.5 (V <= %d; default: none)\n",
+      DACPO_SCENE_MAX_VIEWS);
   printf("  -seed S          random seed (default: %llu)\n",
          (unsigned long long)d.seed);
   printf("  -offset X,Y,Z    add this offset and write double x y z (as georeferenced\n"

@@ -327,15 +327,17 @@ typedef struct dacpo_stats {
                                    layered_doubled fired): points whose PCA axis
                                    turned by over 20 degrees at twice the
                                    neighbours and held at a larger scale */
-  size_t frame_sensors;       /**< FREE_SPACE: windows of consecutive points (4096,
-                                   two tilings) whose own sampling density places
-                                   a depth sensor and its side: the frames of a
-                                   scan whose points come frame by frame; 0 for a
-                                   cloud whose order says nothing */
+  size_t frame_sensors;       /**< FREE_SPACE: windows (about 4096 points) of the
+                                   frames found in the point order (registered
+                                   depth frames concatenated, each row by row)
+                                   whose own sampling density places a depth
+                                   sensor and its side and falls with range along
+                                   each surface; 0 for a cloud whose order shows
+                                   no frame */
   size_t frame_turned;        /**< distinct points turned to face their frame's
-                                   sensor, the last sign pass: both windows
-                                   holding the point found one and see it within
-                                   60 degrees of its normal, facing away; or
+                                   sensor, the last sign pass: its frame's
+                                   window counts in frame_sensors and sees it
+                                   within 60 degrees of its normal, facing away; or
                                    its block turned whole, where at least 5 %
                                    of its points say so and under a quarter
                                    as many say the opposite */

@@ -37,6 +37,7 @@
 
 #include "dacpo_kdtree.h"
 #include "dacpo_rng.h"
+#include "dacpo_surface_vote.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -228,22 +229,22 @@ dacpo_single_view_sensor(const double* xyz,
   return DACPO_OK;
 }
 
-/* ---- One window of consecutive points ------------------------------------
+/* ---- One window of one frame --------------------------------------------
  *
  * Why: registered depth frames concatenated into one cloud keep their points
  * frame by frame. In the whole cloud the frames' densities add up and no one
- * sensor explains them, but a window of consecutive points, its densities
- * taken among its own points only, is one frame (or a part of one) again.
- * Where the frame sees more than one plane, the densities also say on which
- * side of the surfaces the sensor stands: from a candidate behind them the
- * near surfaces are the far ones, so its fit falls under
- * DACPO_SINGLE_VIEW_FIT (or its slope under DACPO_SINGLE_VIEW_SLOPE). A
- * window whose fit reaches DACPO_SENSOR_FIT while no candidate on the other
- * side reaches DACPO_SINGLE_VIEW_FIT has a sensor with a side; a flat window
- * fits its sensor's mirror image as well and has none. A window that holds
- * the end of one frame and the start of the next is a mix: the sensor placed
- * must explain each half of the window's sample (fit >= DACPO_SINGLE_VIEW_FIT)
- * on its own (the sign pass asks the other tiling's window too). */
+ * sensor explains them, but a window of one frame's points (found in the
+ * order, dacpo_frame_sensors.c), its densities taken among its own points
+ * only, is one view again. Where the frame sees more than one plane, the
+ * densities also say on which side of the surfaces the sensor stands: from a
+ * candidate behind them the near surfaces are the far ones, so its fit falls
+ * under DACPO_SINGLE_VIEW_FIT (or its slope under DACPO_SINGLE_VIEW_SLOPE).
+ * A window whose best fit reaches DACPO_SINGLE_VIEW_FIT (as a whole cloud
+ * counts as one view) while no candidate on the other side has the slope
+ * has a sensor with a side; a flat window fits its sensor's mirror image as
+ * well and has none, and a side that other candidates only fit less well
+ * is not decisive (a band of a frame's top rows, ceiling and one wall, fit
+ * 0.56 from the mirror against 0.48 from the camera's side). */
 enum {
   WINDOW_SAMPLE = 512,
   WINDOW_BASES = 64, /* sample points the candidates start from */
@@ -251,6 +252,8 @@ enum {
   WINDOW_MIN = 256, /* points: fewer give no density worth fitting */
   WINDOW_K = 8      /* the k-th neighbour of the densities, as for the cloud */
 };
+/* The fit of a candidate whose slope fails (below any fit). */
+#define WINDOW_NO_SLOPE (-2.0)
 
 /* Candidate k of a window: one of WINDOW_BASES evenly spread sample points
  * pushed along its axis by 1/4, 1/2, 1 or 2 diameters, both ways, so that
@@ -308,9 +311,11 @@ same_side(const dacpo_view_sample* s, const double a[3], const double b[3])
 }
 
 /* The best-fitting candidate (slope >= DACPO_SINGLE_VIEW_SLOPE) when it
- * reaches DACPO_SENSOR_FIT and no candidate seen from the other side reaches
- * DACPO_SINGLE_VIEW_FIT: 1, *best set and *start the candidate on its side
- * with the least spread; else 0. fit, cand: scratch for WINDOW_CANDIDATES. */
+ * reaches DACPO_SINGLE_VIEW_FIT and no candidate seen from the other side
+ * has the slope (from every place behind the surfaces the density falls the
+ * wrong way: the side is decisive): 1, *best set and *start the candidate on
+ * its side with the least spread; else 0. fit, cand: scratch for
+ * WINDOW_CANDIDATES. */
 static int
 window_sided_fit(const dacpo_view_sample* s,
                  const double* logd,
@@ -325,16 +330,16 @@ window_sided_fit(const dacpo_view_sample* s,
     double slope = 0.0;
     fit[k] = dacpo_view_density_fit(s, logd, cand + 3 * k, &slope);
     if (slope < DACPO_SINGLE_VIEW_SLOPE)
-      fit[k] = -1.0;
+      fit[k] = WINDOW_NO_SLOPE;
     if (fit[k] > fit[top])
       top = k;
   }
-  if (fit[top] < DACPO_SENSOR_FIT)
+  if (fit[top] < DACPO_SINGLE_VIEW_FIT)
     return 0;
   double least = HUGE_VAL;
   for (size_t k = 0; k < WINDOW_CANDIDATES; ++k) {
     const int same = same_side(s, cand + 3 * top, cand + 3 * k);
-    if (!same && fit[k] >= DACPO_SINGLE_VIEW_FIT)
+    if (!same && fit[k] > WINDOW_NO_SLOPE)
       return 0;
     const double spread = same ? sensor_spread(s, logd, cand + 3 * k) : HUGE_VAL;
     if (spread < least) {
@@ -346,19 +351,30 @@ window_sided_fit(const dacpo_view_sample* s,
   return 1;
 }
 
-/* Each half of the sample on its own fits the sensor at v. */
-static int
-halves_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
+/* Uncentred correlation, over the pairs of sample points that continue one
+ * smooth surface (dacpo_smooth_pair at DACPO_SURFACE_VOTE_ANGLE), of the
+ * pair's difference in log density with its difference in the model of a
+ * sensor at v: how well the sensor explains the density along each surface,
+ * not only its steps from one surface to the next. 0 without such pairs. */
+static double
+window_surface_fit(const dacpo_view_sample* s, const double* logd, const double v[3])
 {
-  const size_t h = s->m / 2;
-  dacpo_view_sample half = *s;
-  half.m = h;
-  if (dacpo_view_density_fit(&half, logd, v, NULL) < DACPO_SINGLE_VIEW_FIT)
-    return 0;
-  half.p = s->p + 3 * h;
-  half.n = s->n + 3 * h;
-  half.m = s->m - h;
-  return dacpo_view_density_fit(&half, logd + h, v, NULL) >= DACPO_SINGLE_VIEW_FIT;
+  const double rad = DACPO_SURFACE_VOTE_ANGLE * (3.14159265358979323846 / 180.0);
+  const double cos_a = cos(rad), sin_a = sin(rad);
+  double model[WINDOW_SAMPLE];
+  for (size_t i = 0; i < s->m; ++i)
+    model[i] = model_log_density(s, i, v);
+  double sab = 0.0, saa = 0.0, sbb = 0.0;
+  for (size_t i = 0; i < s->m; ++i)
+    for (size_t j = i + 1; j < s->m; ++j) {
+      if (!dacpo_smooth_pair(s->p, s->n, i, j, cos_a, sin_a))
+        continue;
+      const double a = logd[i] - logd[j], b = model[i] - model[j];
+      sab += a * b;
+      saa += a * a;
+      sbb += b * b;
+    }
+  return saa > 0.0 && sbb > 0.0 ? sab / sqrt(saa * sbb) : 0.0;
 }
 
 dacpo_status
@@ -366,14 +382,16 @@ dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
                     int* found,
+                    int* along,
                     double sensor[3],
                     dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && axes && found && sensor,
+              xyz && axes && found && along && sensor,
               DACPO_ERR_INVALID_ARGUMENT,
               "window sensor: NULL argument");
   *found = 0;
+  *along = 0;
   if (m < WINDOW_MIN)
     return DACPO_OK;
   dacpo_view_sample vs;
@@ -391,7 +409,9 @@ dacpo_window_sensor(const double* xyz,
   double best[3];
   if (window_sided_fit(&vs, logd, fit, cand, best, sensor)) {
     refine_sensor(&vs, logd, sensor);
-    *found = same_side(&vs, best, sensor) && halves_fit(&vs, logd, sensor);
+    *found = same_side(&vs, best, sensor);
+    *along =
+        *found && window_surface_fit(&vs, logd, sensor) >= 3.0 / sqrt((double)vs.m);
   }
   free(logd);
   free(fit);

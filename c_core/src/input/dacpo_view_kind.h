@@ -52,20 +52,27 @@ dacpo_single_view_sensor(const double* xyz,
                          double sensor[3],
                          dacpo_err* err);
 
-/* The sensor of one window of consecutive points of a cloud (xyz, axes: m
- * points and unit axes, 3m each), as registered depth frames concatenated
- * keep them: *found = 1 and sensor set when the window's own densities (its
- * 8th neighbours among its m points) place one sensor (fit >=
- * DACPO_SENSOR_FIT, each half of the window explained on its own) and say on
- * which side of the surfaces it stands (no candidate seen from the other side
- * fits >= DACPO_SINGLE_VIEW_FIT); else *found = 0 (a flat window, a window of
- * many views or of uniform density, fewer than 256 points). Deterministic.
- * Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
+/* The sensor of one window of one frame's points (xyz, axes: m points and
+ * unit axes, 3m each), as registered depth frames concatenated keep them:
+ * *found = 1 and sensor set when the window's own densities (its 8th
+ * neighbours among its m points) place one sensor (fit >=
+ * DACPO_SINGLE_VIEW_FIT) and say on which side of the surfaces it stands (no
+ * candidate seen from the other side has the density fall with range as
+ * seen from it); else *found = 0 (a flat
+ * window, a window of many views or of uniform density, fewer than 256
+ * points). *along = 1 where found and the sensor also explains the density
+ * along the window's smooth surfaces (correlation of the differences over
+ * pairs on one surface at least 3 / sqrt(sample size): three standard errors
+ * above none): a frame, whose density falls with range across each surface,
+ * not a cloud sampled surface by surface, whose density steps between
+ * surfaces a far sensor can explain while each surface is uniform.
+ * Deterministic. Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
                     int* found,
+                    int* along,
                     double sensor[3],
                     dacpo_err* err);
 

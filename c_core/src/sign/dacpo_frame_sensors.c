@@ -6,29 +6,143 @@
  * cloud whose points come frame by frame, each surface seen two or more times
  * with the pose errors' offsets. Whether two offset sheets are copies of one
  * surface or the two faces of a thin solid is what the geometry alone cannot
- * tell; the frames that saw them can: every point a sensor saw faces it. A
- * window of consecutive points is one frame, or the end of one and the start
- * of the next, and its own densities place its sensor and its side where it
- * has one (dacpo_window_sensor, dacpo_view_kind.c). A cloud whose order says
- * nothing (voxel-merged, shuffled, sampled from a mesh) has windows of many
- * views or uniform density: none is found and nothing changes.
+ * tell; the frames that saw them can: every point a sensor saw faces it.
+ * Where the order shows where each frame ends, a window of one frame's points
+ * places its sensor and its side from its own densities where it has one
+ * (dacpo_window_sensor, dacpo_view_kind.c). A cloud whose order shows no
+ * frame (one view, shuffled, sampled uniformly) has no window; one whose
+ * order cuts often (voxel-merged) has windows of uniform density, and one
+ * sampled surface by surface has windows whose sensor does not explain the
+ * density along each surface: nothing changes there.
  *
- * Cost: per window a kd-tree over its points, 512 density terms for each of
- * 512 candidates, and the sensor's placement (a compass search) where one
- * fits; windows run in parallel.
+ * Cost: two passes over the order, FRAME_REACH places each; per window a
+ * kd-tree over its points, 512 density terms for each of 512 candidates, and
+ * the sensor's placement (a compass search) where one fits; windows run in
+ * parallel.
  */
 #include "dacpo_frame_sensors.h"
 
 #include "dacpo_parallel.h"
 #include "dacpo_view_kind.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 enum {
-  FRAME_WINDOW = 4096,    /* points per window (DACPO_VIEW_SAMPLE) */
-  FRAME_MAX_WINDOWS = 256 /* per tiling: longer windows beyond a million points */
+  FRAME_WINDOW = 4096,    /* points per band of a frame (DACPO_VIEW_SAMPLE) */
+  FRAME_MAX_WINDOWS = 256 /* longer bands beyond a million points */
 };
+
+/* Frames found in the order. A depth frame's points come row by row, so
+ * across any place inside a frame some point lies within a few spacings of
+ * a point at most FRAME_REACH places before it (the row above, the point
+ * before); across the place where one frame ends and the next starts (the
+ * last rows of one, the first rows of the other) next to none does. */
+enum {
+  FRAME_REACH = 256,  /* places looked back along the order */
+  FRAME_MIN = 1024,   /* points: a shorter frame gets no window */
+  FRAME_SPACINGS = 3, /* "near": within 3 order spacings */
+  FRAME_SAMPLE = 4096 /* places sampled for the median */
+};
+/* A cut: the pairs across it fall under a twentieth of the median place's. */
+#define FRAME_CUT_SHARE 0.05
+
+/* Squared distance of points i and j. */
+static double
+dist2(const double* xyz, size_t i, size_t j)
+{
+  const double* a = xyz + 3 * i;
+  const double* b = xyz + 3 * j;
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+         (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+/* near2[i]: the squared distance from point i to its nearest point within
+ * FRAME_REACH places along the order (either way), times FRAME_SPACINGS^2:
+ * a frame's own spacing where i lies, along its row. */
+static void
+order_near(const double* xyz, size_t n, float* near2)
+{
+  for (size_t i = 0; i < n; ++i)
+    near2[i] = INFINITY;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
+    for (size_t j = i + 1; j <= hi; ++j) {
+      const float d2 = (float)dist2(xyz, i, j);
+      near2[i] = fminf(near2[i], d2);
+      near2[j] = fminf(near2[j], d2);
+    }
+  }
+  for (size_t i = 0; i < n; ++i)
+    near2[i] *= (float)(FRAME_SPACINGS * FRAME_SPACINGS);
+}
+
+/* across[b] (b in 1..n-1): the pairs (i, j), i < b <= j <= i + FRAME_REACH,
+ * across the place before point b that lie near (within either one's
+ * near2). */
+static void
+order_crossings(const double* xyz, size_t n, const float* near2, int32_t* across)
+{
+  memset(across, 0, (n + 1) * sizeof(int32_t));
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
+    for (size_t j = i + 1; j <= hi; ++j)
+      if (dist2(xyz, i, j) <= fmaxf(near2[i], near2[j])) {
+        ++across[i + 1];
+        --across[j + 1];
+      }
+  }
+  for (size_t b = 1; b <= n; ++b)
+    across[b] += across[b - 1];
+}
+
+/* The median of across[b] over sampled places b in [FRAME_REACH, n -
+ * FRAME_REACH). */
+static double
+median_crossing(const int32_t* across, size_t n)
+{
+  double v[FRAME_SAMPLE];
+  const size_t span = n - 2 * FRAME_REACH;
+  const size_t step = span / FRAME_SAMPLE + 1;
+  size_t m = 0;
+  for (size_t b = FRAME_REACH; b < n - FRAME_REACH && m < FRAME_SAMPLE; b += step)
+    v[m++] = (double)across[b];
+  return dacpo_select_kth(v, m, m / 2);
+}
+
+/* The cuts between frames, as frame starts: start[0] = 0, start[frames] =
+ * n (capacity n / FRAME_REACH + 3). A cut is the fewest-pairs place of a run
+ * of places under FRAME_CUT_SHARE of the median (runs closer than
+ * FRAME_REACH are one run). Returns the frames, or 0 where the order shows
+ * no cut (or too few near pairs along it to tell). */
+static size_t
+frame_starts(const int32_t* across, size_t n, size_t* start)
+{
+  if (n < 2 * FRAME_MIN)
+    return 0;
+  const double low = FRAME_CUT_SHARE * median_crossing(across, n);
+  if (low < 1.0)
+    return 0;
+  size_t frames = 0, best = 0, last_low = 0;
+  start[0] = 0;
+  for (size_t b = FRAME_REACH; b < n - FRAME_REACH; ++b) {
+    if ((double)across[b] >= low)
+      continue;
+    if (best && b > last_low + FRAME_REACH) { /* the last run ended: its cut */
+      start[++frames] = best;
+      best = 0;
+    }
+    if (best == 0 || across[b] < across[best])
+      best = b;
+    last_low = b;
+  }
+  if (best == 0)
+    return 0;
+  start[++frames] = best;
+  start[++frames] = n;
+  return frames;
+}
 
 typedef struct frame_job {
   const double* xyz;
@@ -42,34 +156,71 @@ frame_window_task(void* user, size_t k, unsigned thread_id, dacpo_err* err)
   (void)thread_id;
   const frame_job* job = user;
   dacpo_frame_windows* w = job->w;
-  int found = 0;
+  int found = 0, along = 0;
   DACPO_TRY(dacpo_window_sensor(job->xyz + 3 * w->first[k],
                                 job->axes + 3 * w->first[k],
                                 w->end[k] - w->first[k],
                                 &found,
+                                &along,
                                 w->sensor + 3 * k,
                                 err));
   w->found[k] = (uint8_t)found;
+  w->along[k] = (uint8_t)along;
   return DACPO_OK;
 }
 
-/* The windows' bounds: tiling 0 at multiples of len, tiling 1 at len / 2
- * plus multiples of len (with the head [0, len / 2) as its first window). */
+/* The windows of each frame of FRAME_MIN points or more: its bands of about
+ * len consecutive points (at least one), and the whole frame where it has
+ * more than one band. A band of rows sees fewer planes than the frame, the
+ * frame more views of itself in a mirror (a room's far walls): each finds
+ * sensors the other misses. A shorter frame (a piece of an order by voxel)
+ * has none. */
 static size_t
-frame_bounds(size_t n, size_t len, size_t* first, size_t* end)
+frame_windows(
+    const size_t* start, size_t frames, size_t len, size_t* first, size_t* end)
 {
   size_t c = 0;
-  for (size_t a = 0; a < n; a += len, ++c) {
-    first[c] = a;
-    end[c] = a + len < n ? a + len : n;
-  }
-  for (size_t a = 0; a < n; ++c) {
-    const size_t b = a == 0 ? len / 2 : a + len;
-    first[c] = a;
-    end[c] = b < n ? b : n;
-    a = end[c];
+  for (size_t f = 0; f < frames; ++f) {
+    const size_t size = start[f + 1] - start[f];
+    if (size < FRAME_MIN)
+      continue;
+    const size_t q = (size + len / 2) / len ? (size + len / 2) / len : 1;
+    for (size_t j = 0; j < q; ++j, ++c) {
+      first[c] = start[f] + size * j / q;
+      end[c] = start[f] + size * (j + 1) / q;
+    }
+    if (q > 1) {
+      first[c] = start[f];
+      end[c++] = start[f + 1];
+    }
   }
   return c;
+}
+
+/* out->frames and their starts (capacity n / FRAME_REACH + 3). */
+static dacpo_status
+find_frames(const double* xyz,
+            size_t n,
+            dacpo_frame_windows* out,
+            size_t* start,
+            dacpo_err* err)
+{
+  out->frames = 0;
+  if (n < 2 * FRAME_MIN)
+    return DACPO_OK;
+  int32_t* across = dacpo_malloc_array(n + 1, sizeof(int32_t));
+  float* near2 = dacpo_malloc_array(n, sizeof(float));
+  if (!across || !near2) {
+    free(across);
+    free(near2);
+    return DACPO_OOM(err);
+  }
+  order_near(xyz, n, near2);
+  order_crossings(xyz, n, near2, across);
+  free(near2);
+  out->frames = frame_starts(across, n, start);
+  free(across);
+  return DACPO_OK;
 }
 
 dacpo_status
@@ -87,18 +238,27 @@ dacpo_frame_windows_find(const double* xyz,
   memset(out, 0, sizeof(*out));
   const size_t by_count = (n + FRAME_MAX_WINDOWS - 1) / FRAME_MAX_WINDOWS;
   const size_t len = by_count > FRAME_WINDOW ? by_count : FRAME_WINDOW;
-  const size_t most = 2 * (n / len + 2);
+  const size_t most = n / len + 2 * (n / FRAME_MIN) + 2;
+  size_t* start = dacpo_malloc_array(n / FRAME_REACH + 3, sizeof(size_t));
   out->first = dacpo_malloc_array(most, sizeof(size_t));
   out->end = dacpo_malloc_array(most, sizeof(size_t));
   out->found = dacpo_calloc_array(most, sizeof(uint8_t));
+  out->along = dacpo_calloc_array(most, sizeof(uint8_t));
   out->sensor = dacpo_calloc_array(3 * most, sizeof(double));
-  if (!out->first || !out->end || !out->found || !out->sensor) {
+  dacpo_status st = DACPO_OK;
+  if (!start || !out->first || !out->end || !out->found || !out->along || !out->sensor)
+    st = DACPO_OOM(err);
+  if (st == DACPO_OK)
+    st = find_frames(xyz, n, out, start, err);
+  if (st != DACPO_OK) {
+    free(start);
     dacpo_frame_windows_free(out);
-    return DACPO_OOM(err);
+    return st;
   }
-  out->count = n ? frame_bounds(n, len, out->first, out->end) : 0;
+  out->count = frame_windows(start, out->frames, len, out->first, out->end);
+  free(start);
   frame_job job = {xyz, axes, out};
-  const dacpo_status st = dacpo_parallel_for(
+  st = dacpo_parallel_for(
       out->count, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
   if (st != DACPO_OK)
     dacpo_frame_windows_free(out);
@@ -113,6 +273,7 @@ dacpo_frame_windows_free(dacpo_frame_windows* w)
   free(w->first);
   free(w->end);
   free(w->found);
+  free(w->along);
   free(w->sensor);
   memset(w, 0, sizeof(*w));
 }

@@ -1,23 +1,31 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* The sensors of a scan's frames, where its points come frame by frame:
- * windows of consecutive points, each with the sensor its own densities
- * place (dacpo_window_sensor), for the last sign pass. */
+ * the frames found in the order, cut into windows, each with the sensor its
+ * own densities place (dacpo_window_sensor), for the last sign pass. */
 #ifndef DACPO_FRAME_SENSORS_H
 #define DACPO_FRAME_SENSORS_H
 
 #include "dacpo_internal.h"
 
 typedef struct dacpo_frame_windows {
-  size_t count;   /* windows, both tilings */
+  size_t count;   /* windows */
   size_t* first;  /* count: first point of each */
   size_t* end;    /* count: one past its last point */
   uint8_t* found; /* count: 1 where a sensor was found (with its side) */
+  uint8_t* along; /* count: 1 where found and it also explains the density
+                     along the window's surfaces (dacpo_window_sensor) */
   double* sensor; /* 3 count: its position where found */
+  size_t frames;  /* frames found in the order (some may hold no window) */
 } dacpo_frame_windows;
 
-/* Windows of consecutive points in two tilings, the second shifted by half a
- * window: every point is in two windows, one of each tiling, which hold
- * different stretches of the order around it.
+/* The frames of the order and their windows. A depth frame's points come
+ * row by row: across any place inside it some point lies within 3 order
+ * spacings (a point's distance to its nearest within 256 places) of one at
+ * most 256 places before it, across the place between two frames next to
+ * none (under a twentieth of the median place's pairs). Each frame of at
+ * least 1,024 points is cut into windows of about the window length; every
+ * point is in at most one window, of its own frame. No cut: no frame, no
+ * window (out->count = 0).
  * Window length: 4096 points, or n / 256 for clouds over a million points.
  * xyz, axes: n points and unit axes (3n each). Deterministic, independent of
  * num_threads (0 = all cores). Failures: NULL argument (INVALID_ARGUMENT),

@@ -828,26 +828,28 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
 }
 
 /* The frames' sensors (dacpo_frame_sensors.c), where the points come frame
- * by frame. A point's word: both windows holding it found a sensor and it
- * faces both the same way squarely. One window alone says nothing: a window
- * that mixes the end of one frame with the start of the next places one
- * sensor for both, and a cloud sampled surface by surface (a mesh's faces, a
- * generated scene's patches) can hold whole surfaces and a part of the next,
- * whose density steps a far sensor explains; the other tiling's window holds
- * other parts. First whole blocks (what stage 2 made consistent) turn where
- * their points' word is decisive: facing away from at least
- * DACPO_FRAME_BLOCK_SHARE of the block, facing under DACPO_SENSOR_MAX_AWAY of
- * that (a flat or grazing frame finds no sensor, so most of a block can go
- * unseen by the pass); then every point its word says faces away turns. */
+ * by frame. A point's word is its own frame's window's: the sensor found
+ * sees it squarely, facing or facing away, and explains the density along
+ * the window's surfaces (a frame's density falls with range across each
+ * surface; a cloud sampled surface by surface, a mesh's faces or a generated
+ * scene's patches, has density steps between surfaces a far sensor explains
+ * while each surface is flat). First whole blocks (what stage 2 made
+ * consistent) turn where their points' word is decisive: facing away from at
+ * least DACPO_FRAME_BLOCK_SHARE of the block, facing under
+ * DACPO_SENSOR_MAX_AWAY of that (a flat or grazing frame finds no sensor, so
+ * most of a block can go unseen by the pass); then every point its word says
+ * faces away turns. */
 #define DACPO_FRAME_BLOCK_SHARE 0.05
 
-/* vote[i] in -2..2: the sum of sensor_side over the found windows holding
- * point i (-2 / +2: both found, both away / both facing). */
+/* vote[i] < 0 / > 0 where point i's word is that it faces away / faces
+ * (above): the sum of sensor_side over the windows of its frame that hold
+ * it (a band and the whole frame: two at most), so where they disagree it
+ * has none. */
 static void
 frame_votes(const run_state* s, const dacpo_frame_windows* w, int8_t* vote)
 {
   for (size_t k = 0; k < w->count; ++k) {
-    if (!w->found[k])
+    if (!w->along[k])
       continue;
     for (size_t i = w->first[k]; i < w->end[k]; ++i)
       vote[i] = (int8_t)(vote[i] + sensor_side(s, i, w->sensor + 3 * k));
@@ -862,8 +864,8 @@ frame_blocks(const run_state* s, const int8_t* vote, uint8_t* turn)
   for (size_t b = 0; b < bl->num_blocks; ++b) {
     size_t away = 0, facing = 0;
     for (size_t j = bl->own_start[b]; j < bl->own_start[b + 1]; ++j) {
-      away += vote[bl->own[j]] == -2;
-      facing += vote[bl->own[j]] == 2;
+      away += vote[bl->own[j]] < 0;
+      facing += vote[bl->own[j]] > 0;
     }
     const double size = (double)(bl->own_start[b + 1] - bl->own_start[b]);
     turn[b] = (uint8_t)((double)away >= DACPO_FRAME_BLOCK_SHARE * size &&
@@ -883,8 +885,8 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
   DACPO_TRY(dacpo_frame_windows_find(
       s->cloud.xyz, s->cloud.nrm, n, s->p.num_threads, &w, err));
   for (size_t k = 0; k < w.count; ++k)
-    st->frame_sensors += w.found[k];
-  if (st->frame_sensors == 0) { /* an order that says nothing: no pass, no buffers */
+    st->frame_sensors += w.along[k];
+  if (st->frame_sensors == 0) { /* no frame with a sensor: no pass, no buffers */
     dacpo_frame_windows_free(&w);
     return DACPO_OK;
   }
@@ -900,7 +902,7 @@ face_the_frame_sensors(run_state* s, dacpo_stats* st, dacpo_err* err)
   }
   for (size_t i = 0; r == DACPO_OK && i < n; ++i) {
     /* its block's turn unless its own word is that it faces; else its word */
-    const int turn = turn_block[s->blocks.block_of[i]] ? vote[i] != 2 : vote[i] == -2;
+    const int turn = turn_block[s->blocks.block_of[i]] ? vote[i] <= 0 : vote[i] < 0;
     if (turn) {
       s->turned[i] = (uint8_t)!s->turned[i];
       ++st->frame_turned;

@@ -21,10 +21,13 @@
  * seed 5) had minorities of 0-9 %. */
 #define DACPO_SURFACE_VOTE_MAX_MINORITY 0.2
 
-/* i ~ j continue one smooth surface: parallel axes, each in the other's
- * tangent plane. */
-static int
-smooth_pair(const double* xyz, const double* axes, size_t i, size_t j, double cos_a, double sin_a)
+int
+dacpo_smooth_pair(const double* xyz,
+                  const double* axes,
+                  size_t i,
+                  size_t j,
+                  double cos_a,
+                  double sin_a)
 {
   const double* a = axes + 3 * i;
   const double* b = axes + 3 * j;
@@ -65,7 +68,7 @@ grow_patch(const double* xyz,
     const size_t i = (size_t)queue[head++];
     for (size_t k = adj->start[i]; k < adj->start[i + 1]; ++k) {
       const size_t j = (size_t)adj->nbr[k];
-      if (rel[j] || !smooth_pair(xyz, axes, i, j, cos_a, sin_a))
+      if (rel[j] || !dacpo_smooth_pair(xyz, axes, i, j, cos_a, sin_a))
         continue;
       const double* a = axes + 3 * i;
       const double* b = axes + 3 * j;

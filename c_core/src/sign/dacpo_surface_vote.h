@@ -10,6 +10,17 @@
  * a neighbour's direction and the tangent plane (degrees). */
 #define DACPO_SURFACE_VOTE_ANGLE 8.0
 
+/* 1 where points i and j (xyz, axes: points and unit axes, 3 per point)
+ * continue one smooth surface: axes within acos(cos_a) of parallel, each
+ * point within asin(sin_a) of the other's tangent plane as seen from it. */
+int
+dacpo_smooth_pair(const double* xyz,
+                  const double* axes,
+                  size_t i,
+                  size_t j,
+                  double cos_a,
+                  double sin_a);
+
 /* Smooth patches: connected regions of the k-NN graph adj whose neighbouring
  * axes are within max_angle_deg of parallel and lie within max_angle_deg of
  * each other's tangent plane (a point of the other face of a thin part lies
