@@ -48,31 +48,53 @@ enum {
 /* A cut: the pairs across it fall under a twentieth of the median place's. */
 #define FRAME_CUT_SHARE 0.05
 
-/* Squared distance of points i and j. */
-static double
-dist2(const double* xyz, size_t i, size_t j)
+/* The points as three float arrays about their centroid: the two passes
+ * below run over them in order, 256 places at a time. */
+typedef struct order_points {
+  float* x;
+  float* y;
+  float* z;
+} order_points;
+
+static int
+order_points_make(const double* xyz, size_t n, order_points* p)
 {
-  const double* a = xyz + 3 * i;
-  const double* b = xyz + 3 * j;
-  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-         (a[2] - b[2]) * (a[2] - b[2]);
+  p->x = dacpo_malloc_array(n ? 3 * n : 1, sizeof(float));
+  if (!p->x)
+    return 0;
+  p->y = p->x + n;
+  p->z = p->y + n;
+  double c[3] = {0.0, 0.0, 0.0};
+  for (size_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      c[d] += xyz[3 * i + d] / (double)n;
+  for (size_t i = 0; i < n; ++i) {
+    p->x[i] = (float)(xyz[3 * i] - c[0]);
+    p->y[i] = (float)(xyz[3 * i + 1] - c[1]);
+    p->z[i] = (float)(xyz[3 * i + 2] - c[2]);
+  }
+  return 1;
 }
 
 /* near2[i]: the squared distance from point i to its nearest point within
  * FRAME_REACH places along the order (either way), times FRAME_SPACINGS^2:
  * a frame's own spacing where i lies, along its row. */
 static void
-order_near(const double* xyz, size_t n, float* near2)
+order_near(const order_points* p, size_t n, float* restrict near2)
 {
   for (size_t i = 0; i < n; ++i)
     near2[i] = INFINITY;
   for (size_t i = 0; i + 1 < n; ++i) {
     const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
+    const float xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    float best = near2[i];
     for (size_t j = i + 1; j <= hi; ++j) {
-      const float d2 = (float)dist2(xyz, i, j);
-      near2[i] = fminf(near2[i], d2);
-      near2[j] = fminf(near2[j], d2);
+      const float dx = p->x[j] - xi, dy = p->y[j] - yi, dz = p->z[j] - zi;
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      best = d2 < best ? d2 : best;
+      near2[j] = d2 < near2[j] ? d2 : near2[j];
     }
+    near2[i] = best;
   }
   for (size_t i = 0; i < n; ++i)
     near2[i] *= (float)(FRAME_SPACINGS * FRAME_SPACINGS);
@@ -82,16 +104,21 @@ order_near(const double* xyz, size_t n, float* near2)
  * across the place before point b that lie near (within either one's
  * near2). */
 static void
-order_crossings(const double* xyz, size_t n, const float* near2, int32_t* across)
+order_crossings(const order_points* p, size_t n, const float* near2, int32_t* restrict across)
 {
   memset(across, 0, (n + 1) * sizeof(int32_t));
   for (size_t i = 0; i + 1 < n; ++i) {
     const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
-    for (size_t j = i + 1; j <= hi; ++j)
-      if (dist2(xyz, i, j) <= fmaxf(near2[i], near2[j])) {
-        ++across[i + 1];
-        --across[j + 1];
-      }
+    const float xi = p->x[i], yi = p->y[i], zi = p->z[i], ni = near2[i];
+    int32_t pairs = 0;
+    for (size_t j = i + 1; j <= hi; ++j) {
+      const float dx = p->x[j] - xi, dy = p->y[j] - yi, dz = p->z[j] - zi;
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      const int32_t near = d2 <= (ni > near2[j] ? ni : near2[j]);
+      pairs += near;
+      across[j + 1] -= near;
+    }
+    across[i + 1] += pairs;
   }
   for (size_t b = 1; b <= n; ++b)
     across[b] += across[b - 1];
@@ -208,16 +235,19 @@ find_frames(const double* xyz,
   out->frames = 0;
   if (n < 2 * FRAME_MIN)
     return DACPO_OK;
+  order_points p = {NULL, NULL, NULL};
   int32_t* across = dacpo_malloc_array(n + 1, sizeof(int32_t));
   float* near2 = dacpo_malloc_array(n, sizeof(float));
-  if (!across || !near2) {
+  if (!across || !near2 || !order_points_make(xyz, n, &p)) {
     free(across);
     free(near2);
+    free(p.x);
     return DACPO_OOM(err);
   }
-  order_near(xyz, n, near2);
-  order_crossings(xyz, n, near2, across);
+  order_near(&p, n, near2);
+  order_crossings(&p, n, near2, across);
   free(near2);
+  free(p.x);
   out->frames = frame_starts(across, n, start);
   free(across);
   return DACPO_OK;
