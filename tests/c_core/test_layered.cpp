@@ -460,46 +460,49 @@ thinPartScore(const dacpo_scene& sc, const std::vector<float>& nrm, double reach
 
 } // namespace
 
-// Known failure (issue: copies or thin solids). The copies' switch is per
-// scene: where the floor shows copies, the two-sheet rule and the side cue go
-// for the whole scan, thin solids included. A thin board's two faces inside a
-// fused room should still come out facing away from each other (scored as
-// returned: faces of a board facing the same way are half wrong whichever
-// way). Measured (scene seed 2, 3 views 8 mm / 0.2 degrees apart, run seed 1):
-// 7,241 thin-part points; AUTO (copies 0.069: rules off) 48.56 % of them wrong,
-// 7.14 % of the whole room; MULTI_VIEW (rules on) 26.31 % of them, 30.83 % of
-// the room (the copies turned over). Enable when a per-region signal tells the
-// board from the copies.
-TEST(DacpoLayered, DISABLED_ThinPartsInAFusedRoomKeepTheirFacesApart)
+// A scan of copies holding thin solids: a room seen by five depth cameras,
+// 20 mm / 0.5 degrees of pose error per view (scene seed 7, 100K points,
+// each view row by row as registered frames concatenated), whose density
+// passes for one view (fit 0.55: the two-sheet rule and the side cue are off
+// for the whole scan, as for copies) and whose thin parts some cameras saw
+// from both sides. Each
+// frame's sensor, found from the order, tells the faces apart where the
+// geometry cannot: the thin parts' points facing the wrong way (a
+// ground-truth normal facing the other way within 3 cm) were 54.86 % of
+// 4,654 with windows of consecutive points, 8.06 % with the frames found
+// (run seed 1). In the other camera rooms with thin parts it is not yet so:
+// docs/DESIGN.md, known limits. (A room fused point by point from random
+// views, `fused_views`, has no frames in its order and keeps its boards'
+// faces facing one way: 48.56 % of them wrong.)
+TEST(DacpoLayered, ThinPartsInAScanOfFramesKeepTheirFacesApart)
 {
-  GeneratedScene fused(roomParams(100000, 3, 2));
-  ASSERT_TRUE(fused.ok);
-  for (dacpo_scan_kind kind : {DACPO_SCAN_AUTO, DACPO_SCAN_MULTI_VIEW}) {
-    std::vector<float> nrm(3 * fused.s.n, 0.0f);
-    dacpo_params p;
-    dacpo_params_init(&p);
-    p.estimate_normals = 1;
-    p.seed = 1;
-    p.scan_kind = kind;
-    dacpo_ctx* ctx = nullptr;
-    ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-    ASSERT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, fused.s.xyz, nrm.data(), fused.s.n),
-              DACPO_OK)
-        << dacpo_ctx_last_error(ctx);
-    const dacpo_stats st = *dacpo_ctx_stats(ctx);
-    dacpo_ctx_free(ctx);
-    size_t thin = 0;
-    const double wrong = thinPartScore(fused.s, nrm, 0.03, &thin);
-    const double all = dacpo_score_oriented(fused.s.normals, nrm.data(), fused.s.n, nullptr, nullptr);
-    printf("fused room (%s): %zu thin-part points, %.2f %% of them wrong, %.2f %% of all "
-           "(copies %.3f, two_sheet %g)\n",
-           kind == DACPO_SCAN_AUTO ? "auto" : "multi",
-           thin,
-           wrong,
-           all,
-           st.layered_copies,
-           st.dipole_two_sheet_used);
-    ASSERT_GT(thin, 1000u);
-    EXPECT_LE(std::min(wrong, 100.0 - wrong), 10.0);
-  }
+  dacpo_scene_params sp = GeneratedScene::params(DACPO_SCENE_ROOM, 100000, 7);
+  sp.views = 5;
+  sp.view_shift = 0.02;
+  sp.view_angle = 0.5;
+  GeneratedScene cams(sp);
+  ASSERT_TRUE(cams.ok);
+  std::vector<float> nrm(3 * cams.s.n, 0.0f);
+  dacpo_params p;
+  dacpo_params_init(&p);
+  p.estimate_normals = 1;
+  p.seed = 1;
+  dacpo_ctx* ctx = nullptr;
+  ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
+  ASSERT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, cams.s.xyz, nrm.data(), cams.s.n), DACPO_OK)
+      << dacpo_ctx_last_error(ctx);
+  const dacpo_stats st = *dacpo_ctx_stats(ctx);
+  dacpo_ctx_free(ctx);
+  size_t thin = 0;
+  const double wrong = thinPartScore(cams.s, nrm, 0.03, &thin);
+  printf("five cameras: %zu thin-part points, %.2f %% of them wrong (two_sheet %g, %zu frame "
+         "sensors)\n",
+         thin,
+         wrong,
+         st.dipole_two_sheet_used,
+         st.frame_sensors);
+  ASSERT_GT(thin, 1000u);
+  EXPECT_EQ(st.dipole_two_sheet_used, 0.0); /* no thin-part rule helps */
+  EXPECT_GT(st.frame_sensors, 0u);
+  EXPECT_LE(wrong, 15.0);
 }
