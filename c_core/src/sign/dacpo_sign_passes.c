@@ -24,7 +24,7 @@
  *                      orientation
  *   9 sensor           per-point turns: in one depth view, every point its
  *                      sensor sees squarely faces it
- *  10 frame sensors    per-point turns: where the points come frame by frame,
+ *  10 frame sensors    block and point turns: where the points come frame by frame,
  *                      every point its frame's sensor sees squarely faces it
  *                      (the last word)
  */
@@ -828,7 +828,7 @@ face_the_sensor(run_state* s, dacpo_stats* st, dacpo_err* err)
 }
 
 /* The frames' sensors (dacpo_frame_sensors.c), where the points come frame
- * by frame. A point's word is its own frame's window's: the sensor found
+ * by frame. A point's word is its own frame's windows': the sensor found
  * sees it squarely, facing or facing away, and explains the density along
  * the window's surfaces (a frame's density falls with range across each
  * surface; a cloud sampled surface by surface, a mesh's faces or a generated
