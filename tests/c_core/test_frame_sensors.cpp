@@ -99,30 +99,12 @@ squarelySeen(const Windows& win,
   }
 }
 
-// Orients n points with estimated normals and run seed 1; the run's stats.
-dacpo_stats
-orientDefault(const float* xyz, size_t n, std::vector<float>* nrm)
-{
-  nrm->assign(3 * n, 0.0f);
-  dacpo_params p;
-  dacpo_params_init(&p);
-  p.estimate_normals = 1;
-  p.seed = 1;
-  dacpo_ctx* ctx = nullptr;
-  EXPECT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  EXPECT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, xyz, nrm->data(), n), DACPO_OK)
-      << dacpo_ctx_last_error(ctx);
-  const dacpo_stats st = *dacpo_ctx_stats(ctx);
-  dacpo_ctx_free(ctx);
-  return st;
-}
-
-// % wrong of scene s oriented by orientDefault; its normals in *nrm, the
+// % wrong of scene s oriented by orientEstimated; its normals in *nrm, the
 // run's stats in *st.
 double
 wrongDefault(const dacpo_scene& s, std::vector<float>* nrm, dacpo_stats* st)
 {
-  *st = orientDefault(s.xyz, s.n, nrm);
+  *st = orientEstimated(s.xyz, s.n, nrm);
   return dacpo_score_oriented(s.normals, nrm->data(), s.n, nullptr, nullptr);
 }
 

@@ -482,17 +482,8 @@ TEST(DacpoLayered, ThinPartsInAScanOfFramesKeepTheirFacesApart)
   sp.view_angle = 0.5;
   GeneratedScene cams(sp);
   ASSERT_TRUE(cams.ok);
-  std::vector<float> nrm(3 * cams.s.n, 0.0f);
-  dacpo_params p;
-  dacpo_params_init(&p);
-  p.estimate_normals = 1;
-  p.seed = 1;
-  dacpo_ctx* ctx = nullptr;
-  ASSERT_EQ(dacpo_ctx_create(&ctx), DACPO_OK);
-  ASSERT_EQ(dacpo_orient(ctx, &p, nullptr, nullptr, cams.s.xyz, nrm.data(), cams.s.n), DACPO_OK)
-      << dacpo_ctx_last_error(ctx);
-  const dacpo_stats st = *dacpo_ctx_stats(ctx);
-  dacpo_ctx_free(ctx);
+  std::vector<float> nrm;
+  const dacpo_stats st = orientEstimated(cams.s.xyz, cams.s.n, &nrm);
   size_t thin = 0;
   const double wrong = thinPartScore(cams.s, nrm, 0.03, &thin);
   printf("five cameras: %zu thin-part points, %.2f %% of them wrong (two_sheet %g, %zu frame "

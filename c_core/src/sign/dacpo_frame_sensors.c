@@ -139,15 +139,13 @@ median_crossing(const int32_t* across, size_t n)
 }
 
 /* The cuts between frames, as frame starts: start[0] = 0, start[frames] =
- * n (capacity n / FRAME_REACH + 3). A cut is the fewest-pairs place of a run
- * of places under FRAME_CUT_SHARE of the median (runs closer than
- * FRAME_REACH are one run). Returns the frames, or 0 where the order shows
- * no cut (or too few near pairs along it to tell). */
+ * n (n >= 2 * FRAME_MIN; capacity n / FRAME_REACH + 3). A cut is the fewest-pairs place
+ * of a run of places under FRAME_CUT_SHARE of the median (runs closer than FRAME_REACH
+ * are one run). Returns the frames, or 0 where the order shows no cut (or too few near
+ * pairs along it to tell). */
 static size_t
 frame_starts(const int32_t* across, size_t n, size_t* start)
 {
-  if (n < 2 * FRAME_MIN)
-    return 0;
   const double low = FRAME_CUT_SHARE * median_crossing(across, n);
   if (low < 1.0)
     return 0;
