@@ -22,6 +22,7 @@ extern "C" {
 #include "dacpo_frame_sensors.h"
 #include "dacpo_scene.h"
 #include "dacpo_score.h"
+#include "dacpo_view_kind.h"
 }
 #include "scene_fixture.hpp"
 
@@ -110,10 +111,95 @@ wrongDefault(const dacpo_scene& s, std::vector<float>* nrm, dacpo_stats* st)
 
 } // namespace
 
+namespace {
+
+// The sensor window [a, b) of room's points places with `camera` (NULL: by
+// its own densities alone); its points' axes are their ground truth.
+dacpo_window_fit
+windowFit(const CameraRoom& room,
+          const std::vector<double>& xyz,
+          size_t a,
+          size_t b,
+          const dacpo_window_points* camera)
+{
+  std::vector<double> axes(room.s.normals + 3 * a, room.s.normals + 3 * b);
+  dacpo_window_fit fit{};
+  dacpo_err err{};
+  EXPECT_EQ(
+      dacpo_window_sensor(xyz.data() + 3 * a, axes.data(), b - a, camera, &fit, &err),
+      DACPO_OK)
+      << err.msg;
+  return fit;
+}
+
+} // namespace
+
+// One camera sees the whole frame: a band of its rows whose densities fit a
+// sensor from both sides of its surfaces (a band that sees a wall and a table
+// top fits the table's mirror image as well) takes the side of its frame's
+// sensor where the frame's window saw the surfaces that tell the two apart
+// squarely. Five cameras, 5 mm / 0.1 degrees (scene seeds 2 and 5): each band
+// so placed stands on its camera's side. Measured: 6 of 8 tied bands placed,
+// 0 of their 17,667 squarely seen points face away.
+TEST(DacpoFrameSensors, TiedBandsTakeTheirFramesSide)
+{
+  size_t tied = 0, placed = 0, away_all = 0, seen_all = 0;
+  for (uint64_t seed : {2u, 5u}) {
+    CameraRoom room(100000, 5, 0.005, 0.1, seed);
+    ASSERT_TRUE(room.ok);
+    const std::vector<double> xyz(room.s.xyz, room.s.xyz + 3 * room.s.n);
+    for (unsigned v = 0; v < room.info.views; ++v) {
+      const size_t a = room.info.view_start[v], b = room.info.view_start[v + 1];
+      const dacpo_window_fit frame = windowFit(room, xyz, a, b, nullptr);
+      if (!frame.found || !frame.along)
+        continue;
+      std::vector<double> axes(room.s.normals + 3 * a, room.s.normals + 3 * b);
+      const dacpo_window_points camera = {
+          xyz.data() + 3 * a, axes.data(), b - a, frame.sensor};
+      const size_t bands = (b - a + 2048) / 4096;
+      for (size_t j = 0; j < bands; ++j) {
+        const size_t first = a + (b - a) * j / bands,
+                     end = a + (b - a) * (j + 1) / bands;
+        const dacpo_window_fit own = windowFit(room, xyz, first, end, nullptr);
+        if (!own.tied)
+          continue;
+        ++tied;
+        EXPECT_FALSE(own.found); /* alone it has no side */
+        const dacpo_window_fit fit = windowFit(room, xyz, first, end, &camera);
+        if (!fit.found)
+          continue;
+        ++placed;
+        size_t away = 0, all = 0;
+        for (size_t i = first; i < end; ++i) {
+          double r[3], rr = 0.0, dot = 0.0;
+          for (int c = 0; c < 3; ++c) {
+            r[c] = fit.sensor[c] - room.s.xyz[3 * i + c];
+            rr += r[c] * r[c];
+            dot += r[c] * room.s.normals[3 * i + c];
+          }
+          all += std::fabs(dot) >= 0.5 * std::sqrt(rr);
+          away += dot <= -0.5 * std::sqrt(rr);
+        }
+        EXPECT_LE(away, all / 100) << "seed " << seed << " view " << v << " band " << j;
+        away_all += away;
+        seen_all += all;
+      }
+    }
+  }
+  printf(
+      "%zu of %zu tied bands placed from their frame's side; %zu of their %zu squarely "
+      "seen points face away\n",
+      placed,
+      tied,
+      away_all,
+      seen_all);
+  EXPECT_GT(placed, 0u);
+}
+
 // Three and five cameras, 5 mm / 0.1 degrees of pose error (scene seed 2):
 // every found window lies inside one camera's points and has its sensor on
 // that camera's side. Measured: 0 of the squarely seen points face away in
-// every found window (13 of 18 and 10 of 20 windows found).
+// every found window (15 of 18 and 11 of 20 windows found).
 TEST(DacpoFrameSensors, EachFoundWindowStandsOnItsCamerasSide)
 {
   for (unsigned views : {3u, 5u}) {

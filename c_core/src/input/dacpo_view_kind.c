@@ -244,7 +244,11 @@ dacpo_single_view_sensor(const double* xyz,
  * has a sensor with a side; a flat window fits its sensor's mirror image as
  * well and has none, and a side that other candidates only fit less well
  * is not decisive (a band of a frame's top rows, ceiling and one wall, fit
- * 0.56 from the mirror against 0.48 from the camera's side). */
+ * 0.56 from the mirror against 0.48 from the camera's side). Such a tied
+ * window takes its side from another window of its frame (the same camera)
+ * where that window saw the surfaces that tell the two sides apart squarely
+ * (tied_side); a band that sees a wall and a table top has the table's
+ * mirror image, which the frame's walls, ceiling or furniture do not. */
 enum {
   WINDOW_SAMPLE = 512,
   WINDOW_BASES = 64, /* sample points the candidates start from */
@@ -310,19 +314,16 @@ same_side(const dacpo_view_sample* s, const double a[3], const double b[3])
   return 2 * same >= s->m;
 }
 
-/* The best-fitting candidate (slope >= DACPO_SINGLE_VIEW_SLOPE) when it
- * reaches DACPO_SINGLE_VIEW_FIT and no candidate seen from the other side
- * has the slope (from every place behind the surfaces the density falls the
- * wrong way: the side is decisive): 1, *best set and *start the candidate on
- * its side with the least spread; else 0. fit, cand: scratch for
- * WINDOW_CANDIDATES. */
-static int
-window_sided_fit(const dacpo_view_sample* s,
-                 const double* logd,
-                 double* fit,
-                 double* cand,
-                 double best[3],
-                 double start[3])
+/* The best-fitting candidate (slope >= DACPO_SINGLE_VIEW_SLOPE): its index,
+ * or -1 when no fit reaches DACPO_SINGLE_VIEW_FIT; *other: the best candidate
+ * seen from the other side that has the slope, -1 if none (the side is
+ * decisive). fit, cand: scratch for WINDOW_CANDIDATES. */
+static long
+window_best_fit(const dacpo_view_sample* s,
+                const double* logd,
+                double* fit,
+                double* cand,
+                long* other)
 {
   size_t top = 0;
   for (size_t k = 0; k < WINDOW_CANDIDATES; ++k) {
@@ -334,21 +335,36 @@ window_sided_fit(const dacpo_view_sample* s,
     if (fit[k] > fit[top])
       top = k;
   }
+  *other = -1;
   if (fit[top] < DACPO_SINGLE_VIEW_FIT)
-    return 0;
+    return -1;
+  for (size_t k = 0; k < WINDOW_CANDIDATES; ++k)
+    if (fit[k] > WINDOW_NO_SLOPE && (*other < 0 || fit[k] > fit[*other]) &&
+        !same_side(s, cand + 3 * top, cand + 3 * k))
+      *other = (long)k;
+  return (long)top;
+}
+
+/* The candidate seen from the side of candidate `ref` with the least spread,
+ * refined (refine_sensor): where a sensor on that side stands. */
+static void
+place_on_side(const dacpo_view_sample* s,
+              const double* logd,
+              const double* cand,
+              size_t ref,
+              double v[3])
+{
   double least = HUGE_VAL;
   for (size_t k = 0; k < WINDOW_CANDIDATES; ++k) {
-    const int same = same_side(s, cand + 3 * top, cand + 3 * k);
-    if (!same && fit[k] > WINDOW_NO_SLOPE)
-      return 0;
-    const double spread = same ? sensor_spread(s, logd, cand + 3 * k) : HUGE_VAL;
+    if (!same_side(s, cand + 3 * ref, cand + 3 * k))
+      continue;
+    const double spread = sensor_spread(s, logd, cand + 3 * k);
     if (spread < least) {
       least = spread;
-      memcpy(start, cand + 3 * k, 3 * sizeof(double));
+      memcpy(v, cand + 3 * k, 3 * sizeof(double));
     }
   }
-  memcpy(best, cand + 3 * top, 3 * sizeof(double));
-  return 1;
+  refine_sensor(s, logd, v);
 }
 
 /* Uncentred correlation, over the pairs of sample points that continue one
@@ -377,45 +393,138 @@ window_surface_fit(const dacpo_view_sample* s, const double* logd, const double 
   return saa > 0.0 && sbb > 0.0 ? sab / sqrt(saa * sbb) : 0.0;
 }
 
+/* A window's sample and the log densities of its points among its own. */
+typedef struct window_density {
+  dacpo_view_sample vs;
+  double* logd;
+} window_density;
+
+static dacpo_status
+window_density_make(
+    const double* xyz, const double* axes, size_t m, window_density* d, dacpo_err* err)
+{
+  d->logd = NULL;
+  DACPO_TRY(
+      dacpo_view_sample_take_at_most(xyz, axes, NULL, m, WINDOW_SAMPLE, &d->vs, err));
+  if (!(d->logd = window_log_density(xyz, m, &d->vs, err))) {
+    dacpo_view_sample_free(&d->vs);
+    return DACPO_OOM(err);
+  }
+  return DACPO_OK;
+}
+
+static void
+window_density_free(window_density* d)
+{
+  free(d->logd);
+  dacpo_view_sample_free(&d->vs);
+}
+
+/* Which of two sensors, a and b, the frame's camera window c (its sample,
+ * its sensor t, placed with its side) stands with: over c's sample points
+ * that t sees squarely (|cos| >= DACPO_SQUARE_COS) and that see a and b from
+ * opposite sides of their plane, those on a's side and those on b's. Returns
+ * 1 (a) or -1 (b) where one side holds DACPO_SIDE_MIN_POINTS of them and the
+ * other under DACPO_SIDE_MAX_AWAY of that, else 0: the camera window saw no
+ * surface that tells a from b, or saw it at grazing. */
+#define DACPO_SQUARE_COS 0.5
+#define DACPO_SIDE_MIN_POINTS 10
+#define DACPO_SIDE_MAX_AWAY 0.25
+static int
+side_of_camera(const dacpo_view_sample* c,
+               const double t[3],
+               const double a[3],
+               const double b[3])
+{
+  size_t with_a = 0, with_b = 0;
+  for (size_t i = 0; i < c->m; ++i) {
+    const double* p = c->p + 3 * i;
+    const double* q = c->n + 3 * i;
+    const double dt[3] = {t[0] - p[0], t[1] - p[1], t[2] - p[2]};
+    const double ft = q[0] * dt[0] + q[1] * dt[1] + q[2] * dt[2];
+    const double fa =
+        q[0] * (a[0] - p[0]) + q[1] * (a[1] - p[1]) + q[2] * (a[2] - p[2]);
+    const double fb =
+        q[0] * (b[0] - p[0]) + q[1] * (b[1] - p[1]) + q[2] * (b[2] - p[2]);
+    if ((fa > 0.0) == (fb > 0.0) ||
+        fabs(ft) <
+            DACPO_SQUARE_COS * sqrt(dt[0] * dt[0] + dt[1] * dt[1] + dt[2] * dt[2]))
+      continue;
+    with_a += (ft > 0.0) == (fa > 0.0);
+    with_b += (ft > 0.0) == (fb > 0.0);
+  }
+  if (with_a >= DACPO_SIDE_MIN_POINTS &&
+      (double)with_b < DACPO_SIDE_MAX_AWAY * (double)with_a)
+    return 1;
+  if (with_b >= DACPO_SIDE_MIN_POINTS &&
+      (double)with_a < DACPO_SIDE_MAX_AWAY * (double)with_b)
+    return -1;
+  return 0;
+}
+
+/* A tied window (w, its candidates cand, side and other the best on either
+ * side): one camera sees the whole frame, so of the sensors placed on each
+ * side the one on the side of the frame's camera window is the frame's
+ * (side_of_camera); none where that window cannot tell. */
+static dacpo_status
+tied_side(const window_density* w,
+          const double* cand,
+          long side,
+          long other,
+          const dacpo_window_points* camera,
+          dacpo_window_fit* out,
+          dacpo_err* err)
+{
+  dacpo_view_sample c;
+  DACPO_TRY(dacpo_view_sample_take_at_most(
+      camera->xyz, camera->axes, NULL, camera->m, WINDOW_SAMPLE, &c, err));
+  double va[3], vb[3];
+  place_on_side(&w->vs, w->logd, cand, (size_t)side, va);
+  place_on_side(&w->vs, w->logd, cand, (size_t)other, vb);
+  const int with = side_of_camera(&c, camera->sensor, va, vb);
+  dacpo_view_sample_free(&c);
+  if (with != 0) {
+    memcpy(out->sensor, with > 0 ? va : vb, sizeof(va));
+    out->found = same_side(&w->vs, cand + 3 * (with > 0 ? side : other), out->sensor);
+  }
+  return DACPO_OK;
+}
+
 dacpo_status
 dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
-                    int* found,
-                    int* along,
-                    double sensor[3],
+                    const dacpo_window_points* camera,
+                    dacpo_window_fit* out,
                     dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && axes && found && along && sensor,
+              xyz && axes && out,
               DACPO_ERR_INVALID_ARGUMENT,
               "window sensor: NULL argument");
-  *found = 0;
-  *along = 0;
+  memset(out, 0, sizeof(*out));
   if (m < WINDOW_MIN)
     return DACPO_OK;
-  dacpo_view_sample vs;
-  DACPO_TRY(
-      dacpo_view_sample_take_at_most(xyz, axes, NULL, m, WINDOW_SAMPLE, &vs, err));
+  window_density w;
+  DACPO_TRY(window_density_make(xyz, axes, m, &w, err));
   double* fit = dacpo_malloc_array(WINDOW_CANDIDATES, sizeof(double));
   double* cand = dacpo_malloc_array(3 * WINDOW_CANDIDATES, sizeof(double));
-  double* logd = fit && cand ? window_log_density(xyz, m, &vs, err) : NULL;
-  if (!logd) {
-    free(fit);
-    free(cand);
-    dacpo_view_sample_free(&vs);
-    return DACPO_OOM(err);
+  dacpo_status st = fit && cand ? DACPO_OK : DACPO_OOM(err);
+  long other = -1;
+  const long side =
+      st == DACPO_OK ? window_best_fit(&w.vs, w.logd, fit, cand, &other) : -1;
+  out->tied = side >= 0 && other >= 0;
+  if (side >= 0 && !out->tied) {
+    place_on_side(&w.vs, w.logd, cand, (size_t)side, out->sensor);
+    out->found = same_side(&w.vs, cand + 3 * side, out->sensor);
   }
-  double best[3];
-  if (window_sided_fit(&vs, logd, fit, cand, best, sensor)) {
-    refine_sensor(&vs, logd, sensor);
-    *found = same_side(&vs, best, sensor);
-    *along =
-        *found && window_surface_fit(&vs, logd, sensor) >= 3.0 / sqrt((double)vs.m);
+  else if (out->tied && camera) {
+    st = tied_side(&w, cand, side, other, camera, out, err);
   }
-  free(logd);
+  out->along = out->found && window_surface_fit(&w.vs, w.logd, out->sensor) >=
+                                 3.0 / sqrt((double)w.vs.m);
   free(fit);
   free(cand);
-  dacpo_view_sample_free(&vs);
-  return DACPO_OK;
+  window_density_free(&w);
+  return st;
 }

@@ -52,28 +52,48 @@ dacpo_single_view_sensor(const double* xyz,
                          double sensor[3],
                          dacpo_err* err);
 
+/* What dacpo_window_sensor finds in a window. */
+typedef struct dacpo_window_fit {
+  int found;        /* a sensor placed, with its side */
+  int along;        /* found, and it explains the density along the surfaces */
+  int tied;         /* a sensor fits from both sides of the surfaces */
+  double sensor[3]; /* where found */
+} dacpo_window_fit;
+
+/* A window of a frame whose sensor has its side: m points and unit axes
+ * (3m each), and the sensor. */
+typedef struct dacpo_window_points {
+  const double* xyz;
+  const double* axes;
+  size_t m;
+  const double* sensor;
+} dacpo_window_points;
+
 /* The sensor of one window of one frame's points (xyz, axes: m points and
  * unit axes, 3m each), as registered depth frames concatenated keep them:
- * *found = 1 and sensor set when the window's own densities (its 8th
+ * out->found = 1 and out->sensor set when the window's own densities (its 8th
  * neighbours among its m points) place one sensor (fit >=
  * DACPO_SINGLE_VIEW_FIT) and say on which side of the surfaces it stands (no
  * candidate seen from the other side has the density fall with range as
- * seen from it); else *found = 0 (a flat
- * window, a window of many views or of uniform density, fewer than 256
- * points). *along = 1 where found and the sensor also explains the density
- * along the window's smooth surfaces (correlation of the differences over
- * pairs on one surface at least 3 / sqrt(sample size): three standard errors
- * above none): a frame, whose density falls with range across each surface,
- * not a cloud sampled surface by surface, whose density steps between
- * surfaces a far sensor can explain while each surface is uniform.
+ * seen from it); else found = 0 (a window of many views or of uniform
+ * density, fewer than 256 points). A window that fits from both sides (a
+ * flat one fits its sensor's mirror image as well) has out->tied = 1 and no
+ * sensor unless `camera` (not NULL: another window of the same frame, whose
+ * sensor has its side) says which: of the sensors placed on either side, the
+ * one from which the camera window's density also falls with range. out->along = 1
+ * where found and the sensor also explains the density along the window's smooth
+ * surfaces (correlation of the differences over pairs on one surface at
+ * least 3 / sqrt(sample size): three standard errors above none): a frame,
+ * whose density falls with range across each surface, not a cloud sampled
+ * surface by surface, whose density steps between surfaces a far sensor can
+ * explain while each surface is uniform.
  * Deterministic. Failures: NULL argument (INVALID_ARGUMENT), OUT_OF_MEMORY. */
 dacpo_status
 dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
-                    int* found,
-                    int* along,
-                    double sensor[3],
+                    const dacpo_window_points* camera,
+                    dacpo_window_fit* out,
                     dacpo_err* err);
 
 /* The fit from which a cloud counts as one depth view (the global sign uses the

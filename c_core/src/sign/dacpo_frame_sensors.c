@@ -9,7 +9,9 @@
  * tell; the frames that saw them can: every point a sensor saw faces it.
  * Where the order shows where each frame ends, a window of one frame's points
  * places its sensor and its side from its own densities where it has one
- * (dacpo_window_sensor, dacpo_view_kind.c). A cloud whose order shows no
+ * (dacpo_window_sensor, dacpo_view_kind.c); a window that fits a sensor from
+ * both sides of its surfaces takes the side of its frame's camera where
+ * another window of the frame places it (tied_windows). A cloud whose order shows no
  * frame (one view, shuffled, sampled uniformly) has no window; one whose
  * order cuts often (voxel-merged) has windows of uniform density, and one
  * sampled surface by surface has windows whose sensor does not explain the
@@ -17,8 +19,8 @@
  *
  * Cost: two passes over the order, FRAME_REACH places each; per window a
  * kd-tree over its points, 512 density terms for each of 512 candidates, and
- * the sensor's placement (a compass search) where one fits; windows run in
- * parallel.
+ * the sensor's placement (a compass search) where one fits; a tied window
+ * once more, with a placement on each side; windows run in parallel.
  */
 #include "dacpo_frame_sensors.h"
 
@@ -173,25 +175,66 @@ typedef struct frame_job {
   const double* xyz;
   const double* axes;
   dacpo_frame_windows* w;
+  uint8_t* tied;        /* count: the window fits from both sides */
+  const size_t* redo;   /* NULL: every window; else the tied ones, redone */
+  const size_t* camera; /* count: the window of a tied one's frame whose
+                           sensor says its side (redo only) */
 } frame_job;
 
 static dacpo_status
-frame_window_task(void* user, size_t k, unsigned thread_id, dacpo_err* err)
+frame_window_task(void* user, size_t t, unsigned thread_id, dacpo_err* err)
 {
   (void)thread_id;
   const frame_job* job = user;
   dacpo_frame_windows* w = job->w;
-  int found = 0, along = 0;
+  const size_t k = job->redo ? job->redo[t] : t;
+  const size_t c = job->redo ? job->camera[k] : k;
+  const dacpo_window_points camera = {job->xyz + 3 * w->first[c],
+                                      job->axes + 3 * w->first[c],
+                                      w->end[c] - w->first[c],
+                                      w->sensor + 3 * c};
+  dacpo_window_fit fit;
   DACPO_TRY(dacpo_window_sensor(job->xyz + 3 * w->first[k],
                                 job->axes + 3 * w->first[k],
                                 w->end[k] - w->first[k],
-                                &found,
-                                &along,
-                                w->sensor + 3 * k,
+                                job->redo ? &camera : NULL,
+                                &fit,
                                 err));
-  w->found[k] = (uint8_t)found;
-  w->along[k] = (uint8_t)along;
+  w->found[k] = (uint8_t)fit.found;
+  w->along[k] = (uint8_t)fit.along;
+  job->tied[k] = (uint8_t)fit.tied;
+  memcpy(w->sensor + 3 * k, fit.sensor, sizeof(fit.sensor));
   return DACPO_OK;
+}
+
+/* One frame, one camera: a window that fits its sensor from both sides of
+ * its surfaces (a band of rows that sees one wall fits the wall's mirror
+ * image as well) takes the side of its frame's sensor where another window
+ * of the frame placed one with its side (found and along; the one of most
+ * points). Windows of one frame are consecutive in the list (frame_windows).
+ * Writes the tied windows that have one to redo, their camera's window to
+ * camera; returns how many. */
+static size_t
+tied_windows(const dacpo_frame_windows* w,
+             const size_t* frame_of,
+             const uint8_t* tied,
+             size_t* redo,
+             size_t* camera)
+{
+  size_t c = 0;
+  for (size_t a = 0, b; a < w->count; a = b) {
+    size_t best = w->count;
+    for (b = a; b < w->count && frame_of[b] == frame_of[a]; ++b)
+      if (w->found[b] && w->along[b] &&
+          (best == w->count || w->end[b] - w->first[b] > w->end[best] - w->first[best]))
+        best = b;
+    for (size_t k = a; best < w->count && k < b; ++k)
+      if (tied[k]) {
+        redo[c++] = k;
+        camera[k] = best;
+      }
+  }
+  return c;
 }
 
 /* The windows of each frame of FRAME_MIN points or more: its bands of about
@@ -201,8 +244,12 @@ frame_window_task(void* user, size_t k, unsigned thread_id, dacpo_err* err)
  * sensors the other misses. A shorter frame (a piece of an order by voxel)
  * has none. */
 static size_t
-frame_windows(
-    const size_t* start, size_t frames, size_t len, size_t* first, size_t* end)
+frame_windows(const size_t* start,
+              size_t frames,
+              size_t len,
+              size_t* first,
+              size_t* end,
+              size_t* frame_of)
 {
   size_t c = 0;
   for (size_t f = 0; f < frames; ++f) {
@@ -213,10 +260,12 @@ frame_windows(
     for (size_t j = 0; j < q; ++j, ++c) {
       first[c] = start[f] + size * j / q;
       end[c] = start[f] + size * (j + 1) / q;
+      frame_of[c] = f;
     }
     if (q > 1) {
       first[c] = start[f];
-      end[c++] = start[f + 1];
+      end[c] = start[f + 1];
+      frame_of[c++] = f;
     }
   }
   return c;
@@ -251,6 +300,45 @@ find_frames(const double* xyz,
   return DACPO_OK;
 }
 
+/* The windows of the frames (start: out->frames + 1 starts; freed here)
+ * and their sensors: every window, then the tied ones with their frame's
+ * side (tied_windows). out is freed on failure. */
+static dacpo_status
+frame_sensors(const double* xyz,
+              const double* axes,
+              unsigned num_threads,
+              size_t* start,
+              size_t len,
+              size_t most,
+              dacpo_frame_windows* out,
+              dacpo_err* err)
+{
+  size_t* frame_of = dacpo_malloc_array(3 * most, sizeof(size_t));
+  uint8_t* tied = dacpo_calloc_array(most, sizeof(uint8_t));
+  dacpo_status st = frame_of && tied ? DACPO_OK : DACPO_OOM(err);
+  if (st == DACPO_OK)
+    out->count = frame_windows(start, out->frames, len, out->first, out->end, frame_of);
+  free(start);
+  frame_job job = {xyz, axes, out, tied, NULL, NULL};
+  if (st == DACPO_OK)
+    st = dacpo_parallel_for(
+        out->count, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
+  size_t* redo = frame_of + most;
+  size_t* camera = redo + most;
+  const size_t again =
+      st == DACPO_OK ? tied_windows(out, frame_of, tied, redo, camera) : 0;
+  job.redo = redo;
+  job.camera = camera;
+  if (st == DACPO_OK && again)
+    st = dacpo_parallel_for(
+        again, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
+  free(frame_of);
+  free(tied);
+  if (st != DACPO_OK)
+    dacpo_frame_windows_free(out);
+  return st;
+}
+
 dacpo_status
 dacpo_frame_windows_find(const double* xyz,
                          const double* axes,
@@ -283,14 +371,7 @@ dacpo_frame_windows_find(const double* xyz,
     dacpo_frame_windows_free(out);
     return st;
   }
-  out->count = frame_windows(start, out->frames, len, out->first, out->end);
-  free(start);
-  frame_job job = {xyz, axes, out};
-  st = dacpo_parallel_for(
-      out->count, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
-  if (st != DACPO_OK)
-    dacpo_frame_windows_free(out);
-  return st;
+  return frame_sensors(xyz, axes, num_threads, start, len, most, out, err);
 }
 
 void

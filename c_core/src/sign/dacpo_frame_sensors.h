@@ -24,8 +24,10 @@ typedef struct dacpo_frame_windows {
  * most 256 places before it, across the place between two frames next to
  * none (under a twentieth of the median place's pairs). Each frame of at
  * least 1,024 points is cut into windows of about the window length; every
- * point is in at most one window, of its own frame. No cut: no frame, no
- * window (out->count = 0).
+ * point is in at most two (a band and the whole frame), of its own frame. A
+ * window whose densities fit a sensor from both sides of its surfaces takes
+ * its side from the frame's window (found and along) of most points where
+ * that one tells (dacpo_window_sensor). No cut: no frame, no window (out->count = 0).
  * Window length: 4096 points, or n / 256 for clouds over a million points.
  * xyz, axes: n points and unit axes (3n each). Deterministic, independent of
  * num_threads (0 = all cores). Failures: NULL argument (INVALID_ARGUMENT),
