@@ -333,8 +333,8 @@ orientCopies(const std::vector<float>& xyz, const std::vector<float>& gt, uint64
 }
 
 // Two copies of one 1 m x 1 m plane (random samples, 2 cm mean spacing), the
-// second `gap` spacings above the first and turned by `tilt` degrees about an
-// in-plane axis (so the copies cross when gap is small); both face +z.
+// second `gap` spacings above the first and turned by `tilt` degrees about the
+// plane's middle line x = 0 (with gap 0 the copies cross there); both face +z.
 // Returns % wrong after orientation from PCA axes (AUTO, seed).
 double
 orientPlaneCopies(double gap, double tilt, uint64_t seed)
@@ -408,20 +408,26 @@ TEST(DacpoLayered, TwoCopiesOfABoxCornerKeepOneOrientation)
     }
 }
 
-// Known failure (issue: copies or thin solids): two copies of a plane with
-// nothing else in the scene are read as the two faces of a thin board, which
-// is the same geometry; the copy rate needs a floor with the scene on one
-// side to tell. Measured (seed 1): 49.5-50.0 % wrong at gaps 0.3-1.5 spacings,
-// tilt 0 or 0.5 degrees. Enable when a region-level signal (copies that
-// cross, no rim) decides it.
-TEST(DacpoLayered, DISABLED_TwoCopiesOfAPlaneKeepOneOrientation)
+// Known failure (issue: copies or thin solids): two copies of a plane that
+// cross (a rotation error between two views tilts one against the other; the
+// copies meet along the plane's middle and lie `gap` spacings apart at its
+// edges), nothing else in the scene. The side cue reads the copies as a thin
+// part's two faces on both sides of the crossing, so each copy faces one way
+// on one side and the other way on the other. Measured (seed 1): 37.60,
+// 44.14, 46.76 % wrong 0.3, 0.8, 1.5 spacings apart; with the cue off
+// (dipole_sides 0) 0.02, 3.62, 21.48 %.
+// Enable when a region-level signal (the copies' offset changing sign across
+// the region) decides it. Two parallel copies with nothing else are the same
+// points as the rimless board of
+// DacpoThinStructures.SheetsSplitIntoPartsStayFacingAway (faces apart): no
+// test can ask one answer of both.
+TEST(DacpoLayered, DISABLED_TwoCrossingCopiesOfAPlaneKeepOneOrientation)
 {
-  for (double gap : {0.3, 0.8, 1.5})
-    for (double tilt : {0.0, 0.5}) {
-      const double wrong = orientPlaneCopies(gap, tilt, 1);
-      printf("plane copies gap %.1f tilt %.1f: %.2f %% wrong\n", gap, tilt, wrong);
-      EXPECT_LE(wrong, 2.0) << "gap " << gap << " tilt " << tilt;
-    }
+  for (double gap : {0.3, 0.8, 1.5}) {
+    const double wrong = orientPlaneCopies(0.0, std::atan(gap * 0.02 / 0.5) * 180.0 / M_PI, 1);
+    printf("crossing plane copies, %.1f spacings apart at the edges: %.2f %% wrong\n", gap, wrong);
+    EXPECT_LE(wrong, 2.0) << "gap " << gap;
+  }
 }
 
 namespace {
