@@ -17,10 +17,11 @@
  * sampled surface by surface has windows whose sensor does not explain the
  * density along each surface: nothing changes there.
  *
- * Cost: two passes over the order, FRAME_REACH places each; per window a
- * kd-tree over its points, 512 density terms for each of 512 candidates, and
- * the sensor's placement (a compass search) where one fits; a tied window
- * once more, with a placement on each side; windows run in parallel.
+ * Cost: two passes over the order, two rows' places each (256 to 4096); per
+ * window a kd-tree over its points, 512 density terms for each of 512
+ * candidates, and the sensor's placement (a compass search) where one fits;
+ * a tied window once more, with a placement on each side; windows run in
+ * parallel.
  */
 #include "dacpo_frame_sensors.h"
 
@@ -38,11 +39,15 @@ enum {
 
 /* Frames found in the order. A depth frame's points come row by row, so
  * across any place inside a frame some point lies within a few spacings of
- * a point at most FRAME_REACH places before it (the row above, the point
+ * a point at most `reach` places before it (the row above, the point
  * before); across the place where one frame ends and the next starts (the
- * last rows of one, the first rows of the other) next to none does. */
+ * last rows of one, the first rows of the other) next to none does. The
+ * reach is two rows (order_row), at least FRAME_REACH places. */
 enum {
-  FRAME_REACH = 256,  /* places looked back along the order */
+  FRAME_REACH = 256,      /* least places looked back along the order */
+  FRAME_MAX_REACH = 4096, /* most (and at most an eighth of the cloud) */
+  FRAME_ROW_SKIP = 8,     /* places of one's own row passed over */
+  FRAME_ROW_SAMPLE = 1024,
   FRAME_MIN = 1024,   /* points: a shorter frame gets no window */
   FRAME_SPACINGS = 3, /* "near": within 3 order spacings */
   FRAME_SAMPLE = 4096 /* places sampled for the median */
@@ -51,7 +56,7 @@ enum {
 #define FRAME_CUT_SHARE 0.05
 
 /* The points as three float arrays about their centroid: the two passes
- * below run over them in order, 256 places at a time. */
+ * below run over them in order, `reach` places at a time. */
 typedef struct order_points {
   float* x;
   float* y;
@@ -78,16 +83,44 @@ order_points_make(const double* xyz, size_t n, order_points* p)
   return 1;
 }
 
+/* The order's row: over FRAME_ROW_SAMPLE points spread along it, the median
+ * number of places back to the first point beyond FRAME_ROW_SKIP places
+ * that lies within FRAME_SPACINGS of the point's spacing along its row (the
+ * nearest of the FRAME_ROW_SKIP before it), at most `most` back: in a depth
+ * frame the pixels above, a row back. 0 if none. */
+static size_t
+order_row(const order_points* p, size_t n, size_t most)
+{
+  double gap[FRAME_ROW_SAMPLE];
+  size_t m = 0;
+  for (size_t s = 0; s < FRAME_ROW_SAMPLE; ++s) {
+    const size_t j = most + (n - most) * s / FRAME_ROW_SAMPLE;
+    float own = INFINITY;
+    for (size_t g = 1; g <= most; ++g) {
+      const float dx = p->x[j - g] - p->x[j], dy = p->y[j - g] - p->y[j],
+                  dz = p->z[j - g] - p->z[j];
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      if (g <= FRAME_ROW_SKIP)
+        own = d2 < own ? d2 : own;
+      else if (d2 <= (float)(FRAME_SPACINGS * FRAME_SPACINGS) * own) {
+        gap[m++] = (double)g;
+        break;
+      }
+    }
+  }
+  return m ? (size_t)dacpo_select_kth(gap, m, m / 2) : 0;
+}
+
 /* near2[i]: the squared distance from point i to its nearest point within
- * FRAME_REACH places along the order (either way), times FRAME_SPACINGS^2:
- * a frame's own spacing where i lies, along its row. */
+ * reach places along the order (either way), times FRAME_SPACINGS^2: a
+ * frame's own spacing where i lies, along its row. */
 static void
-order_near(const order_points* p, size_t n, float* restrict near2)
+order_near(const order_points* p, size_t n, size_t reach, float* restrict near2)
 {
   for (size_t i = 0; i < n; ++i)
     near2[i] = INFINITY;
   for (size_t i = 0; i + 1 < n; ++i) {
-    const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
+    const size_t hi = i + reach < n ? i + reach : n - 1;
     const float xi = p->x[i], yi = p->y[i], zi = p->z[i];
     float best = near2[i];
     for (size_t j = i + 1; j <= hi; ++j) {
@@ -102,15 +135,19 @@ order_near(const order_points* p, size_t n, float* restrict near2)
     near2[i] *= (float)(FRAME_SPACINGS * FRAME_SPACINGS);
 }
 
-/* across[b] (b in 1..n-1): the pairs (i, j), i < b <= j <= i + FRAME_REACH,
+/* across[b] (b in 1..n-1): the pairs (i, j), i < b <= j <= i + reach,
  * across the place before point b that lie near (within either one's
  * near2). */
 static void
-order_crossings(const order_points* p, size_t n, const float* near2, int32_t* restrict across)
+order_crossings(const order_points* p,
+                size_t n,
+                size_t reach,
+                const float* near2,
+                int32_t* restrict across)
 {
   memset(across, 0, (n + 1) * sizeof(int32_t));
   for (size_t i = 0; i + 1 < n; ++i) {
-    const size_t hi = i + FRAME_REACH < n ? i + FRAME_REACH : n - 1;
+    const size_t hi = i + reach < n ? i + reach : n - 1;
     const float xi = p->x[i], yi = p->y[i], zi = p->z[i], ni = near2[i];
     int32_t pairs = 0;
     for (size_t j = i + 1; j <= hi; ++j) {
@@ -126,37 +163,36 @@ order_crossings(const order_points* p, size_t n, const float* near2, int32_t* re
     across[b] += across[b - 1];
 }
 
-/* The median of across[b] over sampled places b in [FRAME_REACH, n -
- * FRAME_REACH). */
+/* The median of across[b] over sampled places b in [reach, n - reach). */
 static double
-median_crossing(const int32_t* across, size_t n)
+median_crossing(const int32_t* across, size_t n, size_t reach)
 {
   double v[FRAME_SAMPLE];
-  const size_t span = n - 2 * FRAME_REACH;
+  const size_t span = n - 2 * reach;
   const size_t step = span / FRAME_SAMPLE + 1;
   size_t m = 0;
-  for (size_t b = FRAME_REACH; b < n - FRAME_REACH && m < FRAME_SAMPLE; b += step)
+  for (size_t b = reach; b < n - reach && m < FRAME_SAMPLE; b += step)
     v[m++] = (double)across[b];
   return dacpo_select_kth(v, m, m / 2);
 }
 
 /* The cuts between frames, as frame starts: start[0] = 0, start[frames] =
- * n (n >= 2 * FRAME_MIN; capacity n / FRAME_REACH + 3). A cut is the fewest-pairs place
- * of a run of places under FRAME_CUT_SHARE of the median (runs closer than FRAME_REACH
+ * n (n >= 8 reach; capacity n / FRAME_REACH + 3). A cut is the fewest-pairs place
+ * of a run of places under FRAME_CUT_SHARE of the median (runs closer than reach
  * are one run). Returns the frames, or 0 where the order shows no cut (or too few near
  * pairs along it to tell). */
 static size_t
-frame_starts(const int32_t* across, size_t n, size_t* start)
+frame_starts(const int32_t* across, size_t n, size_t reach, size_t* start)
 {
-  const double low = FRAME_CUT_SHARE * median_crossing(across, n);
+  const double low = FRAME_CUT_SHARE * median_crossing(across, n, reach);
   if (low < 1.0)
     return 0;
   size_t frames = 0, best = 0, last_low = 0;
   start[0] = 0;
-  for (size_t b = FRAME_REACH; b < n - FRAME_REACH; ++b) {
+  for (size_t b = reach; b < n - reach; ++b) {
     if ((double)across[b] >= low)
       continue;
-    if (best && b > last_low + FRAME_REACH) { /* the last run ended: its cut */
+    if (best && b > last_low + reach) { /* the last run ended: its cut */
       start[++frames] = best;
       best = 0;
     }
@@ -291,11 +327,15 @@ find_frames(const double* xyz,
     free(p.x);
     return DACPO_OOM(err);
   }
-  order_near(&p, n, near2);
-  order_crossings(&p, n, near2, across);
+  const size_t most = n / 8 < FRAME_MAX_REACH ? n / 8 : FRAME_MAX_REACH;
+  const size_t row = order_row(&p, n, most);
+  const size_t reach =
+      2 * row < FRAME_REACH ? FRAME_REACH : (2 * row < most ? 2 * row : most);
+  order_near(&p, n, reach, near2);
+  order_crossings(&p, n, reach, near2, across);
   free(near2);
   free(p.x);
-  out->frames = frame_starts(across, n, start);
+  out->frames = frame_starts(across, n, reach, start);
   free(across);
   return DACPO_OK;
 }

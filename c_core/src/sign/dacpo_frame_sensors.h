@@ -20,9 +20,12 @@ typedef struct dacpo_frame_windows {
 
 /* The frames of the order and their windows. A depth frame's points come
  * row by row: across any place inside it some point lies within 3 order
- * spacings (a point's distance to its nearest within 256 places) of one at
- * most 256 places before it, across the place between two frames next to
- * none (under a twentieth of the median place's pairs). Each frame of at
+ * spacings (a point's distance to its nearest within the reach) of one at
+ * most the reach before it, across the place between two frames next to
+ * none (under a twentieth of the median place's pairs). The reach is two of
+ * the order's rows (the median number of places back to the first point
+ * near a sampled one beyond its own 8 last), 256 to 4,096 places and at most
+ * an eighth of the cloud. Each frame of at
  * least 1,024 points is cut into windows of about the window length; every
  * point is in at most two (a band and the whole frame), of its own frame. A
  * window whose densities fit a sensor from both sides of its surfaces takes
