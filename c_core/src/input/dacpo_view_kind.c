@@ -422,14 +422,12 @@ window_density_free(window_density* d)
 
 /* Which of two sensors, a and b, the frame's camera window c (its sample,
  * its sensor t, placed with its side) stands with: over c's sample points
- * that t sees squarely (|cos| >= DACPO_SQUARE_COS) and that see a and b from
+ * that t sees squarely (DACPO_SENSOR_SQUARE_COS) and that see a and b from
  * opposite sides of their plane, those on a's side and those on b's. Returns
  * 1 (a) or -1 (b) where one side holds DACPO_SIDE_MIN_POINTS of them and the
- * other under DACPO_SIDE_MAX_AWAY of that, else 0: the camera window saw no
- * surface that tells a from b, or saw it at grazing. */
-#define DACPO_SQUARE_COS 0.5
+ * other under DACPO_SENSOR_MAX_AWAY of that, else 0: the camera window saw
+ * no surface that tells a from b, or saw it at grazing. */
 #define DACPO_SIDE_MIN_POINTS 10
-#define DACPO_SIDE_MAX_AWAY 0.25
 static int
 side_of_camera(const dacpo_view_sample* c,
                const double t[3],
@@ -447,17 +445,17 @@ side_of_camera(const dacpo_view_sample* c,
     const double fb =
         q[0] * (b[0] - p[0]) + q[1] * (b[1] - p[1]) + q[2] * (b[2] - p[2]);
     if ((fa > 0.0) == (fb > 0.0) ||
-        fabs(ft) <
-            DACPO_SQUARE_COS * sqrt(dt[0] * dt[0] + dt[1] * dt[1] + dt[2] * dt[2]))
+        fabs(ft) < DACPO_SENSOR_SQUARE_COS *
+                       sqrt(dt[0] * dt[0] + dt[1] * dt[1] + dt[2] * dt[2]))
       continue;
     with_a += (ft > 0.0) == (fa > 0.0);
     with_b += (ft > 0.0) == (fb > 0.0);
   }
   if (with_a >= DACPO_SIDE_MIN_POINTS &&
-      (double)with_b < DACPO_SIDE_MAX_AWAY * (double)with_a)
+      (double)with_b < DACPO_SENSOR_MAX_AWAY * (double)with_a)
     return 1;
   if (with_b >= DACPO_SIDE_MIN_POINTS &&
-      (double)with_a < DACPO_SIDE_MAX_AWAY * (double)with_b)
+      (double)with_a < DACPO_SENSOR_MAX_AWAY * (double)with_b)
     return -1;
   return 0;
 }

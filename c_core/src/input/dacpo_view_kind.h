@@ -109,5 +109,12 @@ dacpo_window_sensor(const double* xyz,
 /* The least slope of log density on the sensor model for a candidate to count
  * (dacpo_single_view_sensor). */
 #define DACPO_SINGLE_VIEW_SLOPE 0.4
+/* A sensor sees a point squarely where the incidence is under 60 degrees
+ * (|cos| of the axis to the ray at least this): nearer grazing the estimated
+ * axis and the estimated sensor decide less surely. */
+#define DACPO_SENSOR_SQUARE_COS 0.5
+/* A side is decisive where those against it are under this share of those
+ * for it (the sensor passes, the frames' block turns, a tied window's side). */
+#define DACPO_SENSOR_MAX_AWAY 0.25
 
 #endif

@@ -40,6 +40,7 @@
 #include "dacpo_job_internal.h"
 #include "dacpo_part_sign.h"
 #include "dacpo_surface_vote.h"
+#include "dacpo_view_kind.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -779,9 +780,8 @@ surface_vote(run_state* s, dacpo_stats* st, dacpo_err* err)
  * density fits one of them, the position found that frame's mirror image
  * (docs/DESIGN.md, "A few frames that pass for one"); nothing turns then
  * either. Under the other policies (SEPARATE, BRIDGE) no vote signed the
- * parts, and a reversed part is what the pass is there to mend. */
-#define DACPO_SENSOR_SQUARE_COS 0.5
-#define DACPO_SENSOR_MAX_AWAY 0.25
+ * parts, and a reversed part is what the pass is there to mend.
+ * (DACPO_SENSOR_SQUARE_COS, DACPO_SENSOR_MAX_AWAY: dacpo_view_kind.h.) */
 
 /* +1 / -1: point i's output normal (its axis, signed as the run signs it now)
  * faces the sensor at v squarely / faces away squarely; 0: seen near grazing. */
