@@ -261,7 +261,7 @@ tied_windows(const dacpo_frame_windows* w,
   for (size_t a = 0, b; a < w->count; a = b) {
     size_t best = w->count;
     for (b = a; b < w->count && frame_of[b] == frame_of[a]; ++b)
-      if (w->found[b] && w->along[b] &&
+      if (w->along[b] && /* along implies found */
           (best == w->count || w->end[b] - w->first[b] > w->end[best] - w->first[best]))
         best = b;
     for (size_t k = a; best < w->count && k < b; ++k)

@@ -25,12 +25,12 @@ typedef struct dacpo_frame_windows {
  * none (under a twentieth of the median place's pairs). The reach is two of
  * the order's rows (the median number of places back to the first point
  * near a sampled one beyond its own 8 last), 256 to 4,096 places and at most
- * an eighth of the cloud. Each frame of at
- * least 1,024 points is cut into windows of about the window length; every
- * point is in at most two (a band and the whole frame), of its own frame. A
- * window whose densities fit a sensor from both sides of its surfaces takes
- * its side from the frame's window (found and along) of most points where
- * that one tells (dacpo_window_sensor). No cut: no frame, no window (out->count = 0).
+ * an eighth of the cloud. Each frame of at least 1,024 points is cut into
+ * windows of about the window length; every point is in at most two (a band
+ * and the whole frame), of its own frame. A window whose densities fit a
+ * sensor from both sides of its surfaces takes its side from the frame's
+ * window (along) of most points where that one tells (dacpo_window_sensor).
+ * No cut: no frame, no window (out->count = 0).
  * Window length: 4096 points, or n / 256 for clouds over a million points.
  * xyz, axes: n points and unit axes (3n each). Deterministic, independent of
  * num_threads (0 = all cores). Failures: NULL argument (INVALID_ARGUMENT),
