@@ -267,6 +267,7 @@ statsDict(const dacpo_stats* s)
   stats["layered_share"] = s->layered_share;
   stats["layered_copies"] = s->layered_copies;
   stats["layered_doubled"] = s->layered_doubled;
+  stats["layered_crossing"] = s->layered_crossing;
   stats["copy_scale_axes"] = s->copy_scale_axes;
   stats["dipole_sides_used"] = s->dipole_sides_used;
   stats["dipole_c_used"] = s->dipole_c_used;

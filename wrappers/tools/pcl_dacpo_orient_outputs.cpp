@@ -243,6 +243,7 @@ printStats(const Result& result)
                "surface_turned=%zu sensor_turned=%zu frame_sensors=%zu "
                "frame_turned=%zu scan=%s single_view_fit=%.3f c=%g "
                "layers=%g two_sheet=%g layered=%.3f copies=%.3f doubled=%.3f "
+               "crossing=%.3f "
                "copy_axes=%zu sides=%g "
                "sign_flipped=%d sign_facing=%.3f sign_enclosed=%d solver_optimal=%d "
                "ipsr_iterations_mean=%.2f "
@@ -273,6 +274,7 @@ printStats(const Result& result)
                s.layered_share,
                s.layered_copies,
                s.layered_doubled,
+               s.layered_crossing,
                s.copy_scale_axes,
                s.dipole_sides_used,
                s.sign_flipped,

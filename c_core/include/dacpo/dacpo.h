@@ -322,6 +322,14 @@ typedef struct dacpo_stats {
                                    (>= 0.2: copies wider apart than the pair
                                    window, handled as layered_copies >= 0.04);
                                    0 when the test did not run */
+  double layered_crossing;    /**< AUTO resolved to many views: where the same
+                                   plane holds two sheets that cross along a line
+                                   (copies tilted against each other, which no
+                                   thin solid's faces can be), the share of its
+                                   two-sheet cells on the smaller side of that
+                                   line, and the scan is handled as copies (as
+                                   layered_copies >= 0.04); 0 when none cross or
+                                   the test did not run */
   size_t copy_scale_axes;     /**< estimated axes taken at a larger scale because
                                    the floor shows copies (layered_copies or
                                    layered_doubled fired): points whose PCA axis

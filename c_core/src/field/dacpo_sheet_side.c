@@ -55,11 +55,6 @@
 #define SIDE_NEIGHBORS 24  /* nearest considered by default (of the K given) */
 #define SIDE_MIN_COS 0.8   /* parallel axes: |a.b| above this */
 #define SIDE_MIN_POINTS 12 /* points needed for the 6-term fit */
-#define SIDE_MIN_CLUSTER 0.25
-#define SIDE_MAX_LATERAL 0.5 /* x mean lateral distance */
-#define SIDE_MIN_GAP 0.3     /* x spacing */
-                             /* x spacing: beyond, the two-sheet rule */
-#define SIDE_SEP_START 5.0
 #define SIDE_SEP_FULL 8.0
 #define SIDE_FIT_ROUNDS 3
 
@@ -171,29 +166,17 @@ surface_fit(const double* u,
   return N;
 }
 
-/* Otsu's two-cluster split of m values: returns the separation
- * (mu_hi - mu_lo) / sigma_within of the best split with both clusters holding
- * >= SIDE_MIN_CLUSTER of the values, and its threshold (0 if none). */
-static double
-otsu_split(const double* r, int m, double* threshold, double* gap)
+double
+dacpo_otsu_sorted(const double* s, size_t m, double* threshold, double* gap)
 {
-  double s[DACPO_SIDE_MAX_NEIGHBORS + 1];
-  for (int k = 0; k < m; ++k) { /* insertion sort: m <= 25 */
-    int j = k;
-    while (j > 0 && s[j - 1] > r[k]) {
-      s[j] = s[j - 1];
-      --j;
-    }
-    s[j] = r[k];
-  }
   double tot = 0.0, tot2 = 0.0;
-  for (int k = 0; k < m; ++k) {
+  for (size_t k = 0; k < m; ++k) {
     tot += s[k];
     tot2 += s[k] * s[k];
   }
-  const int kmin = (int)ceil(SIDE_MIN_CLUSTER * (double)m);
+  const size_t kmin = (size_t)ceil(DACPO_SIDE_MIN_CLUSTER * (double)m);
   double best = 0.0, s1 = 0.0, q1 = 0.0;
-  for (int k = 1; k < m; ++k) {
+  for (size_t k = 1; k < m; ++k) {
     s1 += s[k - 1];
     q1 += s[k - 1] * s[k - 1];
     if (k < kmin || m - k < kmin)
@@ -213,9 +196,25 @@ otsu_split(const double* r, int m, double* threshold, double* gap)
   return best;
 }
 
+/* dacpo_otsu_sorted on m unsorted values (m <= DACPO_SIDE_MAX_NEIGHBORS + 1). */
+static double
+otsu_split(const double* r, int m, double* threshold, double* gap)
+{
+  double s[DACPO_SIDE_MAX_NEIGHBORS + 1];
+  for (int k = 0; k < m; ++k) { /* insertion sort: m <= 25 */
+    int j = k;
+    while (j > 0 && s[j - 1] > r[k]) {
+      s[j] = s[j - 1];
+      --j;
+    }
+    s[j] = r[k];
+  }
+  return dacpo_otsu_sorted(s, (size_t)m, threshold, gap);
+}
+
 /* The faces lie over each other, not beside each other (the terraces of a
  * quantised depth image do): the lateral centroids of the two label groups
- * (l > 0 and l <= 0) are closer than SIDE_MAX_LATERAL mean lateral distances
+ * (l > 0 and l <= 0) are closer than DACPO_SIDE_MAX_LATERAL mean lateral distances
  * (u, v are in that unit). */
 static int
 faces_overlap(const double* u, const double* v, const double* l, int m)
@@ -232,12 +231,12 @@ faces_overlap(const double* u, const double* v, const double* l, int m)
     return 0;
   const double du = c_hi[0] / n_hi - c_lo[0] / (m - n_hi);
   const double dv = c_hi[1] / n_hi - c_lo[1] / (m - n_hi);
-  return sqrt(du * du + dv * dv) < SIDE_MAX_LATERAL;
+  return sqrt(du * du + dv * dv) < DACPO_SIDE_MAX_LATERAL;
 }
 
 /* First test: one quadric through all m points, Otsu's split of its residuals.
  * Writes labels l[k] = +-1/2 (+: the upper group) and returns 1 if the split is
- * clear (separation above SIDE_SEP_START, gap above SIDE_MIN_GAP spacings,
+ * clear (separation above DACPO_SIDE_SEP_START, gap above DACPO_SIDE_MIN_GAP spacings,
  * groups over each other), 0 if not, -1 if there is no split at all (degenerate
  * fit, or no split leaves both groups 25 % of the points; l is not written). */
 static int
@@ -252,7 +251,7 @@ one_surface_split(
     return -1;
   for (int k = 0; k < m; ++k)
     l[k] = r[k] > thr ? 0.5 : -0.5;
-  return sep > SIDE_SEP_START && gap > SIDE_MIN_GAP * spacing &&
+  return sep > DACPO_SIDE_SEP_START && gap > DACPO_SIDE_MIN_GAP * spacing &&
          faces_overlap(u, v, l, m);
 }
 
@@ -309,7 +308,7 @@ two_copy_rounds(const double* u,
  * tilted by whichever face has more points on one side, the shared surface
  * with its gap is not. Returns the confidence in [0, 1] from the separation
  * |gap| / sigma of the residuals about the two copies (0: no clear split, a
- * copy with under 25 % of the points, gap under SIDE_MIN_GAP spacings, or
+ * copy with under 25 % of the points, gap under DACPO_SIDE_MIN_GAP spacings, or
  * copies beside each other); l[k] > 0 then means the copy on the +axis side. */
 static double
 two_copy_fit(const double* u,
@@ -321,13 +320,14 @@ two_copy_fit(const double* u,
              double* gap_out)
 {
   double r[DACPO_SIDE_MAX_NEIGHBORS + 1], gap = 0.0, sep = 0.0;
-  const int kmin = (int)ceil(SIDE_MIN_CLUSTER * (double)m);
+  const int kmin = (int)ceil(DACPO_SIDE_MIN_CLUSTER * (double)m);
   if (two_copy_rounds(u, v, z, m, SIDE_FIT_ROUNDS, kmin, l, r, &gap, &sep) < 0)
     return 0.0;
-  if (!(sep > SIDE_SEP_START) || !(gap > SIDE_MIN_GAP * spacing) ||
+  if (!(sep > DACPO_SIDE_SEP_START) || !(gap > DACPO_SIDE_MIN_GAP * spacing) ||
       !faces_overlap(u, v, l, m))
     return 0.0;
-  const double conf = (sep - SIDE_SEP_START) / (SIDE_SEP_FULL - SIDE_SEP_START);
+  const double conf =
+      (sep - DACPO_SIDE_SEP_START) / (SIDE_SEP_FULL - DACPO_SIDE_SEP_START);
   *gap_out = gap;
   return conf < 1.0 ? conf : 1.0;
 }
@@ -609,7 +609,8 @@ patch_two_faces(const double* xyz,
     return 0.0;
   /* the side (a solid between the copies) only where the copies are as
    * clearly apart as the point test requires */
-  const double clear = (sep - SIDE_SEP_START) / (SIDE_SEP_FULL - SIDE_SEP_START);
+  const double clear =
+      (sep - DACPO_SIDE_SEP_START) / (SIDE_SEP_FULL - DACPO_SIDE_SEP_START);
   *sharp = clear < 0.0 ? 0.0 : (clear < 1.0 ? clear : 1.0);
   return conf < 1.0 ? conf : 1.0;
 }

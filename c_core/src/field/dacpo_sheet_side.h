@@ -29,6 +29,24 @@ void
 dacpo_tangent_frame(const double a[3], double e1[3], double e2[3]);
 
 #define SIDE_HIDDEN (-2)
+/* A clear split into two faces (also the band's crossing test,
+ * dacpo_sheets_cross.c): each group holds this share of the points ... */
+#define DACPO_SIDE_MIN_CLUSTER 0.25
+/* ... their lateral centroids lie closer than this many mean lateral
+ * distances (over each other, not beside each other) ... */
+#define DACPO_SIDE_MAX_LATERAL 0.5
+/* ... the gap exceeds this many spacings ... */
+#define DACPO_SIDE_MIN_GAP 0.3
+/* ... and this many deviations of the residuals (noise alone reaches ~5
+ * with 25 points). */
+#define DACPO_SIDE_SEP_START 5.0
+
+/* Otsu's two-group split of m sorted values s: the separation
+ * (mu_hi - mu_lo) / sigma_within of the best split that leaves both groups
+ * DACPO_SIDE_MIN_CLUSTER of the values, its threshold and mu_hi - mu_lo in
+ * *threshold and *gap (not written, and 0 returned, if there is none). */
+double
+dacpo_otsu_sorted(const double* s, size_t m, double* threshold, double* gap);
 #define DACPO_SIDE_MAX_NEIGHBORS 32
 
 dacpo_status

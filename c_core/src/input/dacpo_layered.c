@@ -38,6 +38,7 @@
 #include "dacpo_dipole.h"
 #include "dacpo_kdtree.h"
 #include "dacpo_sheet_side.h"
+#include "dacpo_sheets_cross.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -51,6 +52,7 @@
 #define LAYERED_CANDIDATES 256
 #define LAYERED_BAND 3.0 /* band thickness, spacings */
 #define LAYERED_K 32     /* neighbours of the side test (as stage 2 on many views) */
+#define LAYERED_CROSS_POINTS 262144 /* slab points the crossing test reads */
 
 #define LAYERED_PAIR_NOISE 3.0 /* stage 2's default two-sheet factor */
 #define LAYERED_PAIRS 3
@@ -534,6 +536,42 @@ probe_band(const double* xyz,
   return DACPO_OK;
 }
 
+/* dacpo_sheets_cross on the points of the slab around the band parallel to
+ * it (every step-th where there are more than LAYERED_CROSS_POINTS), in the
+ * band's frame. */
+static dacpo_status
+slab_crossing(const double* xyz,
+              const double* axes,
+              size_t n,
+              const double dir[3],
+              double lo,
+              double width,
+              double spacing,
+              double* crossing,
+              dacpo_err* err)
+{
+  size_t in = 0;
+  for (size_t i = 0; i < n; ++i)
+    in += in_slab(dir, lo, width, xyz + 3 * i, axes + 3 * i);
+  /* every step-th of them: at most LAYERED_CROSS_POINTS */
+  const size_t step = in > LAYERED_CROSS_POINTS ? in / LAYERED_CROSS_POINTS + 1 : 1;
+  double* uvy = dacpo_malloc_array(3 * (in / step + 1), sizeof(double));
+  if (!uvy)
+    return DACPO_OOM(err);
+  double e1[3], e2[3];
+  dacpo_tangent_frame(dir, e1, e2);
+  size_t seen = 0, m = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (in_slab(dir, lo, width, xyz + 3 * i, axes + 3 * i) && seen++ % step == 0) {
+      uvy[3 * m] = dot3(e1, xyz + 3 * i);
+      uvy[3 * m + 1] = dot3(e2, xyz + 3 * i);
+      uvy[3 * m++ + 2] = dot3(dir, xyz + 3 * i);
+    }
+  const dacpo_status st = dacpo_sheets_cross(uvy, m, spacing, crossing, err);
+  free(uvy);
+  return st;
+}
+
 /* Row t of the side test's local set: sample point pick (slab index) at
  * position t, its LAYERED_K nearest slab points copied to positions
  * s + t LAYERED_K ..., padded with copies of itself. */
@@ -661,15 +699,18 @@ dacpo_layered_share(const double* xyz,
                     double* share,
                     double* copies,
                     double* doubled,
+                    double* crossing,
                     dacpo_err* err)
 {
   DACPO_CHECK(err,
-              xyz && axes && knn_idx && knn_sqd && share && copies && doubled,
+              xyz && axes && knn_idx && knn_sqd && share && copies && doubled &&
+                  crossing,
               DACPO_ERR_INVALID_ARGUMENT,
               "layered test: NULL argument");
   *share = 0.0;
   *copies = 0.0;
   *doubled = 0.0;
+  *crossing = 0.0;
   if (n <= LAYERED_K || knn_k < LAYERED_PAIRS)
     return DACPO_OK;
   double spacing = 0.0, dir[3] = {0.0, 0.0, 0.0}, lo = 0.0;
@@ -693,19 +734,23 @@ dacpo_layered_share(const double* xyz,
       nb_band += in_band(dir, lo, width, xyz + 3 * i, axes + 3 * i);
     }
   }
-  /* Only a plane with the scene on one side of it, like a floor or a wall
-   * seen from inside, cannot be a thin solid: a board or a partition has
-   * things on both sides, or nothing at all (a scan of one board). */
+  if (nb_band < DACPO_LAYERED_MIN_BAND)
+    return DACPO_OK;
+  /* Two sheets that cross are copies wherever the scene lies. Otherwise only
+   * a plane with the scene on one side of it, like a floor or a wall seen
+   * from inside, cannot be a thin solid: a board or a partition has things
+   * on both sides, or nothing at all (a scan of one board). */
+  DACPO_TRY(slab_crossing(xyz, axes, n, dir, lo, width, spacing, crossing, err));
   const size_t beyond = below + above;
   size_t minority = 0;
-  if (nb_band < DACPO_LAYERED_MIN_BAND ||
-      (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n)
+  if (*crossing == 0.0 && (double)beyond < DACPO_LAYERED_MIN_BEYOND * (double)n)
     return DACPO_OK;
-  DACPO_TRY(
-      minority_under_band(xyz, axes, n, dir, lo, width, below < above, &minority, err));
+  if (*crossing == 0.0)
+    DACPO_TRY(minority_under_band(
+        xyz, axes, n, dir, lo, width, below < above, &minority, err));
   if ((double)minority > DACPO_LAYERED_MAX_OTHER_SIDE * (double)beyond)
     return DACPO_OK;
-  if (under_scene(xyz, axes, n, dir, lo, width))
+  if (*crossing > 0.0 || under_scene(xyz, axes, n, dir, lo, width))
     DACPO_TRY(copy_rates(xyz,
                          axes,
                          n,

@@ -25,6 +25,12 @@
  * than the pair window, as whole frames off by 2 cm. Both 0 where *share is 0
  * for want of a band.
  *
+ * *crossing: where the slab's parallel points hold two sheets that cross
+ * along a line (dacpo_sheets_cross: copies tilted against each other, which
+ * no thin solid's faces can be), the share of its two-sheet cells on the
+ * smaller side of the line, else 0. A crossing band qualifies whatever lies
+ * around it, so *share, *copies and *doubled are measured on it too.
+ *
  * xyz, axes: n points and unit axes (3n each); knn_idx, knn_sqd: n x knn_k
  * nearest neighbours (self excluded, nearest first, -1 / inf padded) and their
  * squared distances.
@@ -39,6 +45,7 @@ dacpo_layered_share(const double* xyz,
                     double* share,
                     double* copies,
                     double* doubled,
+                    double* crossing,
                     dacpo_err* err);
 /* From this copy rate on, the two-sheet rule (its pairs and c_thin) is left
  * out as well as the side cue: copies lie on the floor everywhere, not only

@@ -607,8 +607,10 @@ resolve_copies(run_state* s, dacpo_stats* st, dacpo_err* err)
                                 &st->layered_share,
                                 &st->layered_copies,
                                 &st->layered_doubled,
+                                &st->layered_crossing,
                                 err));
-  const int copies = st->layered_copies >= DACPO_LAYERED_COPIES ||
+  const int copies = st->layered_crossing > 0.0 ||
+                     st->layered_copies >= DACPO_LAYERED_COPIES ||
                      st->layered_doubled >= DACPO_LAYERED_DOUBLED;
   if (st->layered_share >= DACPO_LAYERED_SHARE || copies)
     s->p.dipole_sides = 0.0;
@@ -638,6 +640,7 @@ resolve_scan_kind(run_state* s, dacpo_stats* st, dacpo_err* err)
   st->layered_share = 0.0;
   st->layered_copies = 0.0;
   st->layered_doubled = 0.0;
+  st->layered_crossing = 0.0;
   st->copy_scale_axes = 0;
   /* the sensor's fit and position: for the kind (AUTO) and, in one view, for
    * the last sign pass, which turns the points it sees squarely to face it */
