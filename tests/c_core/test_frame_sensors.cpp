@@ -125,9 +125,9 @@ windowFit(const CameraRoom& room,
   std::vector<double> axes(room.s.normals + 3 * a, room.s.normals + 3 * b);
   dacpo_window_fit fit{};
   dacpo_err err{};
-  EXPECT_EQ(
-      dacpo_window_sensor(xyz.data() + 3 * a, axes.data(), b - a, camera, &fit, &err),
-      DACPO_OK)
+  EXPECT_EQ(dacpo_window_sensor(
+                xyz.data() + 3 * a, axes.data(), b - a, camera, nullptr, &fit, &err),
+            DACPO_OK)
       << err.msg;
   return fit;
 }
@@ -386,4 +386,27 @@ TEST(DacpoFrameSensors, FramesFoundInTheOrderMendWhatTheirCamerasSaw)
          st.frame_turned);
   EXPECT_GT(st.frame_turned, 3000u);
   EXPECT_LE(wrong, 2.0);
+}
+
+// Eight cameras, 5 mm / 0.1 degrees (scene seed 7, 100K points): one frame
+// sees only a 10 cm partition's far face, another only a 2 cm board's face
+// that the other cameras saw from behind. Flat, each fits its sensor's mirror
+// image across the face as well, and no window of the frame places its
+// camera, so the parts' vote turned both faces over (23.18 % wrong, run seed
+// 1). The mirror image looks at the face through the partition's or the
+// board's other face, which other frames saw: the side from which the face is
+// not hidden is its camera's (dacpo_free_space.c). Measured: 0.39 %.
+TEST(DacpoFrameSensors, AFaceHiddenFromTheMirrorFacesItsCamera)
+{
+  CameraRoom room(100000, 8, 0.005, 0.1, 7);
+  ASSERT_TRUE(room.ok);
+  std::vector<float> nrm;
+  dacpo_stats st{};
+  const double wrong = wrongDefault(room.s, &nrm, &st);
+  printf(
+      "eight cameras, scene 7: %.2f %% wrong; %zu frame sensors, %zu points turned\n",
+      wrong,
+      st.frame_sensors,
+      st.frame_turned);
+  EXPECT_LE(wrong, 5.0);
 }

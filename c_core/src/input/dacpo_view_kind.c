@@ -460,27 +460,85 @@ side_of_camera(const dacpo_view_sample* c,
   return 0;
 }
 
+/* 1 if sensor v sees p (axis q) squarely (DACPO_SENSOR_SQUARE_COS). */
+static int
+sees_squarely(const double* p, const double* q, const double v[3])
+{
+  const double d[3] = {v[0] - p[0], v[1] - p[1], v[2] - p[2]};
+  return fabs(q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) >=
+         DACPO_SENSOR_SQUARE_COS * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+/* 1 if v lies inside the cloud's box (sp->lo, sp->hi). */
+static int
+in_box(const dacpo_window_space* sp, const double v[3])
+{
+  for (int d = 0; d < 3; ++d)
+    if (!(v[d] >= sp->lo[d] && v[d] <= sp->hi[d]))
+      return 0;
+  return 1;
+}
+
+/* Which of two sensors, a and b, saw the window's sample s: over the points
+ * both see squarely, those hidden from a behind points of other frames and
+ * those hidden from b (dacpo_free_space_blocked). Returns 1 (a) or -1 (b)
+ * where the other is hidden from DACPO_SIDE_MIN_POINTS and this one from
+ * under DACPO_SENSOR_MAX_AWAY of that, and this one stands inside the
+ * cloud's box; else 0. Out there nothing was scanned that could hide a
+ * point, so a clear view says nothing: a wall's mirror sensor, outside the
+ * room, sees it clearly, while the camera's placement, off by decimetres,
+ * may look at it past a thing in the room. */
+static int
+free_side(const dacpo_view_sample* s,
+          const double a[3],
+          const double b[3],
+          const dacpo_window_space* sp)
+{
+  size_t hid_a = 0, hid_b = 0;
+  for (size_t i = 0; i < s->m; ++i) {
+    const double* p = s->p + 3 * i;
+    if (!sees_squarely(p, s->n + 3 * i, a) || !sees_squarely(p, s->n + 3 * i, b))
+      continue;
+    hid_a += (size_t)dacpo_free_space_blocked(sp->space, p, a, sp->skip, sp->frame);
+    hid_b += (size_t)dacpo_free_space_blocked(sp->space, p, b, sp->skip, sp->frame);
+  }
+  if (hid_b >= DACPO_SIDE_MIN_POINTS &&
+      (double)hid_a < DACPO_SENSOR_MAX_AWAY * (double)hid_b && in_box(sp, a))
+    return 1;
+  if (hid_a >= DACPO_SIDE_MIN_POINTS &&
+      (double)hid_b < DACPO_SENSOR_MAX_AWAY * (double)hid_a && in_box(sp, b))
+    return -1;
+  return 0;
+}
+
 /* A tied window (w, its candidates cand, side and other the best on either
  * side): one camera sees the whole frame, so of the sensors placed on each
  * side the one on the side of the frame's camera window is the frame's
- * (side_of_camera); none where that window cannot tell. */
+ * (side_of_camera); where that window cannot tell (or there is none), the
+ * one the window's points are not hidden from (free_side); else none. */
 static dacpo_status
 tied_side(const window_density* w,
           const double* cand,
           long side,
           long other,
           const dacpo_window_points* camera,
+          const dacpo_window_space* space,
           dacpo_window_fit* out,
           dacpo_err* err)
 {
-  dacpo_view_sample c;
-  DACPO_TRY(dacpo_view_sample_take_at_most(
-      camera->xyz, camera->axes, NULL, camera->m, WINDOW_SAMPLE, &c, err));
   double va[3], vb[3];
   place_on_side(&w->vs, w->logd, cand, (size_t)side, va);
   place_on_side(&w->vs, w->logd, cand, (size_t)other, vb);
-  const int with = side_of_camera(&c, camera->sensor, va, vb);
-  dacpo_view_sample_free(&c);
+  int with = 0;
+  if (camera) {
+    dacpo_view_sample c;
+    DACPO_TRY(dacpo_view_sample_take_at_most(
+        camera->xyz, camera->axes, NULL, camera->m, WINDOW_SAMPLE, &c, err));
+    with = side_of_camera(&c, camera->sensor, va, vb);
+    dacpo_view_sample_free(&c);
+  }
+  if (with == 0 && space)
+    with = free_side(&w->vs, va, vb, space);
   if (with != 0) {
     memcpy(out->sensor, with > 0 ? va : vb, sizeof(va));
     out->found = same_side(&w->vs, cand + 3 * (with > 0 ? side : other), out->sensor);
@@ -493,6 +551,7 @@ dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
                     const dacpo_window_points* camera,
+                    const dacpo_window_space* space,
                     dacpo_window_fit* out,
                     dacpo_err* err)
 {
@@ -516,8 +575,8 @@ dacpo_window_sensor(const double* xyz,
     place_on_side(&w.vs, w.logd, cand, (size_t)side, out->sensor);
     out->found = same_side(&w.vs, cand + 3 * side, out->sensor);
   }
-  else if (out->tied && camera) {
-    st = tied_side(&w, cand, side, other, camera, out, err);
+  else if (out->tied && (camera || space)) {
+    st = tied_side(&w, cand, side, other, camera, space, out, err);
   }
   out->along = out->found && window_surface_fit(&w.vs, w.logd, out->sensor) >=
                                  3.0 / sqrt((double)w.vs.m);

@@ -3,6 +3,7 @@
 #ifndef DACPO_VIEW_KIND_H
 #define DACPO_VIEW_KIND_H
 
+#include "dacpo_free_space.h"
 #include "dacpo_internal.h"
 #include "dacpo_part_sign.h"
 
@@ -69,6 +70,16 @@ typedef struct dacpo_window_points {
   const double* sensor;
 } dacpo_window_points;
 
+/* The space the window's frame and the other frames saw through
+ * (dacpo_free_space.c): `frame` is the window's own, `skip` the length left
+ * out at either end of a segment, lo and hi the cloud's box. */
+typedef struct dacpo_window_space {
+  const dacpo_free_space* space;
+  uint32_t frame;
+  double skip;
+  double lo[3], hi[3];
+} dacpo_window_space;
+
 /* The sensor of one window of one frame's points (xyz, axes: m points and
  * unit axes, 3m each), as registered depth frames concatenated keep them:
  * out->found = 1 and out->sensor set when the window's own densities (its 8th
@@ -80,7 +91,10 @@ typedef struct dacpo_window_points {
  * flat one fits its sensor's mirror image as well) has out->tied = 1 and no
  * sensor unless `camera` (not NULL: another window of the same frame, whose
  * sensor has its side) says which: of the sensors placed on either side, the
- * one from which the camera window's density also falls with range. out->along = 1
+ * one on the camera's side of the surfaces that tell them apart; or, where
+ * it does not tell, `space` (not NULL): of the two, the one inside the
+ * cloud's box from which the window's points are not hidden behind points of
+ * other frames while they are from the other. out->along = 1
  * where found and the sensor also explains the density along the window's smooth
  * surfaces (correlation of the differences over pairs on one surface at
  * least 3 / sqrt(sample size): three standard errors above none): a frame,
@@ -93,6 +107,7 @@ dacpo_window_sensor(const double* xyz,
                     const double* axes,
                     size_t m,
                     const dacpo_window_points* camera,
+                    const dacpo_window_space* space,
                     dacpo_window_fit* out,
                     dacpo_err* err);
 

@@ -11,7 +11,10 @@
  * places its sensor and its side from its own densities where it has one
  * (dacpo_window_sensor, dacpo_view_kind.c); a window that fits a sensor from
  * both sides of its surfaces takes the side of its frame's camera where
- * another window of the frame places it (tied_windows). A cloud whose order shows no
+ * another window of the frame places it (tied_windows), or else the side
+ * from which other frames' points do not hide it (a frame that sees only a
+ * partition's far face: its mirror sensor would look through the near face
+ * that other frames saw). A cloud whose order shows no
  * frame (one view, shuffled, sampled uniformly) has no window; one whose
  * order cuts often (voxel-merged) has windows of uniform density, and one
  * sampled surface by surface has windows whose sensor does not explain the
@@ -20,11 +23,13 @@
  * Cost: two passes over the order, two rows' places each (256 to 4096); per
  * window a kd-tree over its points, 512 density terms for each of 512
  * candidates, and the sensor's placement (a compass search) where one fits;
- * a tied window once more, with a placement on each side; windows run in
- * parallel.
+ * a tied window once more, with a placement on each side and, where its
+ * frame's camera does not tell, 512 segments walked through a hash of the
+ * occupied cells (made once, O(n)); windows run in parallel.
  */
 #include "dacpo_frame_sensors.h"
 
+#include "dacpo_free_space.h"
 #include "dacpo_parallel.h"
 #include "dacpo_view_kind.h"
 
@@ -54,6 +59,12 @@ enum {
 };
 /* A cut: the pairs across it fall under a twentieth of the median place's. */
 #define FRAME_CUT_SHARE 0.05
+/* The free space of a tied window's side (dacpo_free_space.c): cells of 1.5
+ * order spacings (the median distance to the nearest point along a frame's
+ * rows), and 4 of them left out at either end of a segment: the surface's
+ * own copies (a few millimetres of registration error) and noise. */
+#define FRAME_SPACE_CELL 1.5
+#define FRAME_SPACE_SKIP 4.0
 
 /* The points as three float arrays about their centroid: the two passes
  * below run over them in order, `reach` places at a time. */
@@ -214,8 +225,14 @@ typedef struct frame_job {
   uint8_t* tied;        /* count: the window fits from both sides */
   const size_t* redo;   /* NULL: every window; else the tied ones, redone */
   const size_t* camera; /* count: the window of a tied one's frame whose
-                           sensor says its side (redo only) */
+                           sensor says its side, or NO_CAMERA (redo only) */
+  const size_t* frame_of;        /* count: each window's frame */
+  const dacpo_free_space* space; /* redo only: where the frames saw through */
+  double skip;                   /* left out at either end of a segment */
+  double lo[3], hi[3];           /* the cloud's box */
 } frame_job;
+
+#define NO_CAMERA ((size_t)-1)
 
 static dacpo_status
 frame_window_task(void* user, size_t t, unsigned thread_id, dacpo_err* err)
@@ -224,16 +241,21 @@ frame_window_task(void* user, size_t t, unsigned thread_id, dacpo_err* err)
   const frame_job* job = user;
   dacpo_frame_windows* w = job->w;
   const size_t k = job->redo ? job->redo[t] : t;
-  const size_t c = job->redo ? job->camera[k] : k;
+  const size_t c = job->redo && job->camera[k] != NO_CAMERA ? job->camera[k] : k;
   const dacpo_window_points camera = {job->xyz + 3 * w->first[c],
                                       job->axes + 3 * w->first[c],
                                       w->end[c] - w->first[c],
                                       w->sensor + 3 * c};
+  dacpo_window_space space = {
+      job->space, (uint32_t)job->frame_of[k], job->skip, {0}, {0}};
+  memcpy(space.lo, job->lo, sizeof(space.lo));
+  memcpy(space.hi, job->hi, sizeof(space.hi));
   dacpo_window_fit fit;
   DACPO_TRY(dacpo_window_sensor(job->xyz + 3 * w->first[k],
                                 job->axes + 3 * w->first[k],
                                 w->end[k] - w->first[k],
-                                job->redo ? &camera : NULL,
+                                job->redo && c != k ? &camera : NULL,
+                                job->redo && job->space ? &space : NULL,
                                 &fit,
                                 err));
   w->found[k] = (uint8_t)fit.found;
@@ -247,9 +269,9 @@ frame_window_task(void* user, size_t t, unsigned thread_id, dacpo_err* err)
  * its surfaces (a band of rows that sees one wall fits the wall's mirror
  * image as well) takes the side of its frame's sensor where another window
  * of the frame placed one with its side (found and along; the one of most
- * points). Windows of one frame are consecutive in the list (frame_windows).
- * Writes the tied windows that have one to redo, their camera's window to
- * camera; returns how many. */
+ * points), else the side the frames' free space allows. Windows of one frame
+ * are consecutive in the list (frame_windows). Writes the tied windows to
+ * redo, their camera's window (or NO_CAMERA) to camera; returns how many. */
 static size_t
 tied_windows(const dacpo_frame_windows* w,
              const size_t* frame_of,
@@ -264,10 +286,10 @@ tied_windows(const dacpo_frame_windows* w,
       if (w->along[b] && /* along implies found */
           (best == w->count || w->end[b] - w->first[b] > w->end[best] - w->first[best]))
         best = b;
-    for (size_t k = a; best < w->count && k < b; ++k)
+    for (size_t k = a; k < b; ++k)
       if (tied[k]) {
         redo[c++] = k;
-        camera[k] = best;
+        camera[k] = best < w->count ? best : NO_CAMERA;
       }
   }
   return c;
@@ -307,15 +329,32 @@ frame_windows(const size_t* start,
   return c;
 }
 
-/* out->frames and their starts (capacity n / FRAME_REACH + 3). */
+/* The median of sqrt(near2) / FRAME_SPACINGS over sampled points: the order
+ * spacing. */
+static double
+order_spacing(const float* near2, size_t n)
+{
+  double v[FRAME_SAMPLE];
+  const size_t step = n / FRAME_SAMPLE + 1;
+  size_t m = 0;
+  for (size_t i = 0; i < n && m < FRAME_SAMPLE; i += step)
+    if (isfinite(near2[i]))
+      v[m++] = sqrt((double)near2[i]) / FRAME_SPACINGS;
+  return m ? dacpo_select_kth(v, m, m / 2) : 0.0;
+}
+
+/* out->frames and their starts (capacity n / FRAME_REACH + 3); *spacing: the
+ * order spacing (order_spacing). */
 static dacpo_status
 find_frames(const double* xyz,
             size_t n,
             dacpo_frame_windows* out,
             size_t* start,
+            double* spacing,
             dacpo_err* err)
 {
   out->frames = 0;
+  *spacing = 0.0;
   if (n < 2 * FRAME_MIN)
     return DACPO_OK;
   order_points p = {NULL, NULL, NULL};
@@ -333,11 +372,49 @@ find_frames(const double* xyz,
       2 * row < FRAME_REACH ? FRAME_REACH : (2 * row < most ? 2 * row : most);
   order_near(&p, n, reach, near2);
   order_crossings(&p, n, reach, near2, across);
+  *spacing = order_spacing(near2, n);
   free(near2);
   free(p.x);
   out->frames = frame_starts(across, n, reach, start);
   free(across);
   return DACPO_OK;
+}
+
+static void
+cloud_box(const double* xyz, size_t n, double lo[3], double hi[3])
+{
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = INFINITY;
+    hi[d] = -INFINITY;
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = fmin(lo[d], xyz[3 * i + d]);
+      hi[d] = fmax(hi[d], xyz[3 * i + d]);
+    }
+}
+
+/* The free space of the frames (start: frames + 1 starts) with cells of
+ * FRAME_SPACE_CELL spacings. */
+static dacpo_status
+frames_space(const double* xyz,
+             size_t n,
+             const size_t* start,
+             size_t frames,
+             double spacing,
+             dacpo_free_space* space,
+             dacpo_err* err)
+{
+  uint32_t* frame = dacpo_malloc_array(n ? n : 1, sizeof(uint32_t));
+  if (!frame)
+    return DACPO_OOM(err);
+  for (size_t f = 0; f < frames; ++f)
+    for (size_t i = start[f]; i < start[f + 1]; ++i)
+      frame[i] = (uint32_t)f;
+  const dacpo_status st =
+      dacpo_free_space_make(xyz, n, frame, FRAME_SPACE_CELL * spacing, space, err);
+  free(frame);
+  return st;
 }
 
 /* The windows of the frames (start: out->frames + 1 starts; freed here)
@@ -346,8 +423,10 @@ find_frames(const double* xyz,
 static dacpo_status
 frame_sensors(const double* xyz,
               const double* axes,
+              size_t n,
               unsigned num_threads,
               size_t* start,
+              double spacing,
               size_t len,
               size_t most,
               dacpo_frame_windows* out,
@@ -358,8 +437,19 @@ frame_sensors(const double* xyz,
   dacpo_status st = frame_of && tied ? DACPO_OK : DACPO_OOM(err);
   if (st == DACPO_OK)
     out->count = frame_windows(start, out->frames, len, out->first, out->end, frame_of);
-  free(start);
-  frame_job job = {xyz, axes, out, tied, NULL, NULL};
+  dacpo_free_space space = {0};
+  frame_job job = {xyz,
+                   axes,
+                   out,
+                   tied,
+                   NULL,
+                   NULL,
+                   frame_of,
+                   NULL,
+                   FRAME_SPACE_SKIP * spacing,
+                   {0},
+                   {0}};
+  cloud_box(xyz, n, job.lo, job.hi);
   if (st == DACPO_OK)
     st = dacpo_parallel_for(
         out->count, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
@@ -367,11 +457,16 @@ frame_sensors(const double* xyz,
   size_t* camera = redo + most;
   const size_t again =
       st == DACPO_OK ? tied_windows(out, frame_of, tied, redo, camera) : 0;
+  if (again && spacing > 0.0)
+    st = frames_space(xyz, n, start, out->frames, spacing, &space, err);
   job.redo = redo;
   job.camera = camera;
+  job.space = space.key ? &space : NULL;
   if (st == DACPO_OK && again)
     st = dacpo_parallel_for(
         again, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
+  dacpo_free_space_free(&space);
+  free(start);
   free(frame_of);
   free(tied);
   if (st != DACPO_OK)
@@ -402,16 +497,17 @@ dacpo_frame_windows_find(const double* xyz,
   out->along = dacpo_calloc_array(most, sizeof(uint8_t));
   out->sensor = dacpo_calloc_array(3 * most, sizeof(double));
   dacpo_status st = DACPO_OK;
+  double spacing = 0.0;
   if (!start || !out->first || !out->end || !out->found || !out->along || !out->sensor)
     st = DACPO_OOM(err);
   if (st == DACPO_OK)
-    st = find_frames(xyz, n, out, start, err);
+    st = find_frames(xyz, n, out, start, &spacing, err);
   if (st != DACPO_OK) {
     free(start);
     dacpo_frame_windows_free(out);
     return st;
   }
-  return frame_sensors(xyz, axes, num_threads, start, len, most, out, err);
+  return frame_sensors(xyz, axes, n, num_threads, start, spacing, len, most, out, err);
 }
 
 void

@@ -29,7 +29,10 @@ typedef struct dacpo_frame_windows {
  * windows of about the window length; every point is in at most two (a band
  * and the whole frame), of its own frame. A window whose densities fit a
  * sensor from both sides of its surfaces takes its side from the frame's
- * window (along) of most points where that one tells (dacpo_window_sensor).
+ * window (along) of most points where that one tells, else from the space
+ * the frames saw through: the placement inside the cloud's box from which
+ * other frames' points do not hide it (dacpo_window_sensor,
+ * dacpo_free_space.c).
  * No cut: no frame, no window (out->count = 0).
  * Window length: 4096 points, or n / 256 for clouds over a million points.
  * xyz, axes: n points and unit axes (3n each). Deterministic, independent of
