@@ -55,6 +55,10 @@ TEST(DacpoFreeSpace, OtherFramesStandInTheWayOwnPointsDoNot)
   EXPECT_EQ(dacpo_free_space_blocked(&space, p, near, 0.03, 0), 0);
   const double far_out[3] = {-3.0, -2.0, 5.0};
   EXPECT_EQ(dacpo_free_space_blocked(&space, p, far_out, 0.03, 0), 0);
+  // the box of the points: the mirror stands outside it, a point between the faces inside
+  const double between[3] = {0.05, 0.5, 0.5};
+  EXPECT_EQ(dacpo_free_space_inside(&space, between), 1);
+  EXPECT_EQ(dacpo_free_space_inside(&space, east), 0);
   dacpo_free_space_free(&space);
   dacpo_free_space_free(&space); // twice is harmless
 }

@@ -65,16 +65,19 @@ dacpo_free_space_make(const double* xyz,
               "free space: NULL argument or cell %g",
               cell);
   memset(out, 0, sizeof(*out));
-  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  out->origin[0] = out->origin[1] = out->origin[2] = INFINITY;
+  for (int d = 0; d < 3; ++d) {
+    out->origin[d] = INFINITY;
+    out->top[d] = -INFINITY;
+  }
   for (size_t i = 0; i < n; ++i)
     for (int d = 0; d < 3; ++d) {
       out->origin[d] = fmin(out->origin[d], xyz[3 * i + d]);
-      hi[d] = fmax(hi[d], xyz[3 * i + d]);
+      out->top[d] = fmax(out->top[d], xyz[3 * i + d]);
     }
   out->cell = cell;
   for (int d = 0; d < 3 && n; ++d)
-    out->cell = fmax(out->cell, (hi[d] - out->origin[d]) / (2.0 * SPACE_SPAN - 2.0));
+    out->cell =
+        fmax(out->cell, (out->top[d] - out->origin[d]) / (2.0 * SPACE_SPAN - 2.0));
   size_t cap = 1024;
   while (cap < 2 * n)
     cap *= 2;
@@ -108,6 +111,15 @@ dacpo_free_space_free(dacpo_free_space* s)
   free(s->lo);
   free(s->hi);
   memset(s, 0, sizeof(*s));
+}
+
+int
+dacpo_free_space_inside(const dacpo_free_space* s, const double v[3])
+{
+  for (int d = 0; d < 3; ++d)
+    if (!(v[d] >= s->origin[d] && v[d] <= s->top[d]))
+      return 0;
+  return 1;
 }
 
 int

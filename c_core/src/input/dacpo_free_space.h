@@ -9,7 +9,8 @@
  * highest frame among its points: a hash of the occupied cells only. */
 typedef struct dacpo_free_space {
   double cell;
-  double origin[3];
+  double origin[3]; /* the points' box: lowest corner ... */
+  double top[3];    /* ... and highest */
   size_t mask;   /* capacity - 1 (a power of two) */
   uint64_t* key; /* cell key + 1; 0: empty slot */
   uint32_t* lo;  /* lowest frame holding a point in the cell */
@@ -29,6 +30,10 @@ dacpo_free_space_make(const double* xyz,
 
 void
 dacpo_free_space_free(dacpo_free_space* s);
+
+/* 1 if v lies inside the box of the points the cells were made from. */
+int
+dacpo_free_space_inside(const dacpo_free_space* s, const double v[3]);
 
 /* 1 if the segment from p to v, less `skip` at each end (a surface's own
  * copies and noise near p, the sensor's own surroundings), passes through a

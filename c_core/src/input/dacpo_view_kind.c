@@ -469,16 +469,6 @@ sees_squarely(const double* p, const double* q, const double v[3])
          DACPO_SENSOR_SQUARE_COS * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
-/* 1 if v lies inside the cloud's box (sp->lo, sp->hi). */
-static int
-in_box(const dacpo_window_space* sp, const double v[3])
-{
-  for (int d = 0; d < 3; ++d)
-    if (!(v[d] >= sp->lo[d] && v[d] <= sp->hi[d]))
-      return 0;
-  return 1;
-}
-
 /* Which of two sensors, a and b, saw the window's sample s: over the points
  * both see squarely, those hidden from a behind points of other frames and
  * those hidden from b (dacpo_free_space_blocked). Returns 1 (a) or -1 (b)
@@ -503,10 +493,12 @@ free_side(const dacpo_view_sample* s,
     hid_b += (size_t)dacpo_free_space_blocked(sp->space, p, b, sp->skip, sp->frame);
   }
   if (hid_b >= DACPO_SIDE_MIN_POINTS &&
-      (double)hid_a < DACPO_SENSOR_MAX_AWAY * (double)hid_b && in_box(sp, a))
+      (double)hid_a < DACPO_SENSOR_MAX_AWAY * (double)hid_b &&
+      dacpo_free_space_inside(sp->space, a))
     return 1;
   if (hid_a >= DACPO_SIDE_MIN_POINTS &&
-      (double)hid_b < DACPO_SENSOR_MAX_AWAY * (double)hid_a && in_box(sp, b))
+      (double)hid_b < DACPO_SENSOR_MAX_AWAY * (double)hid_a &&
+      dacpo_free_space_inside(sp->space, b))
     return -1;
   return 0;
 }

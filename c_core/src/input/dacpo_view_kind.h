@@ -72,12 +72,11 @@ typedef struct dacpo_window_points {
 
 /* The space the window's frame and the other frames saw through
  * (dacpo_free_space.c): `frame` is the window's own, `skip` the length left
- * out at either end of a segment, lo and hi the cloud's box. */
+ * out at either end of a segment. */
 typedef struct dacpo_window_space {
   const dacpo_free_space* space;
   uint32_t frame;
   double skip;
-  double lo[3], hi[3];
 } dacpo_window_space;
 
 /* The sensor of one window of one frame's points (xyz, axes: m points and

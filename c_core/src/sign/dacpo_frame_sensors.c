@@ -229,7 +229,6 @@ typedef struct frame_job {
   const size_t* frame_of;        /* count: each window's frame */
   const dacpo_free_space* space; /* redo only: where the frames saw through */
   double skip;                   /* left out at either end of a segment */
-  double lo[3], hi[3];           /* the cloud's box */
 } frame_job;
 
 #define NO_CAMERA ((size_t)-1)
@@ -246,10 +245,7 @@ frame_window_task(void* user, size_t t, unsigned thread_id, dacpo_err* err)
                                       job->axes + 3 * w->first[c],
                                       w->end[c] - w->first[c],
                                       w->sensor + 3 * c};
-  dacpo_window_space space = {
-      job->space, (uint32_t)job->frame_of[k], job->skip, {0}, {0}};
-  memcpy(space.lo, job->lo, sizeof(space.lo));
-  memcpy(space.hi, job->hi, sizeof(space.hi));
+  const dacpo_window_space space = {job->space, (uint32_t)job->frame_of[k], job->skip};
   dacpo_window_fit fit;
   DACPO_TRY(dacpo_window_sensor(job->xyz + 3 * w->first[k],
                                 job->axes + 3 * w->first[k],
@@ -380,20 +376,6 @@ find_frames(const double* xyz,
   return DACPO_OK;
 }
 
-static void
-cloud_box(const double* xyz, size_t n, double lo[3], double hi[3])
-{
-  for (int d = 0; d < 3; ++d) {
-    lo[d] = INFINITY;
-    hi[d] = -INFINITY;
-  }
-  for (size_t i = 0; i < n; ++i)
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = fmin(lo[d], xyz[3 * i + d]);
-      hi[d] = fmax(hi[d], xyz[3 * i + d]);
-    }
-}
-
 /* The free space of the frames (start: frames + 1 starts) with cells of
  * FRAME_SPACE_CELL spacings. */
 static dacpo_status
@@ -438,18 +420,8 @@ frame_sensors(const double* xyz,
   if (st == DACPO_OK)
     out->count = frame_windows(start, out->frames, len, out->first, out->end, frame_of);
   dacpo_free_space space = {0};
-  frame_job job = {xyz,
-                   axes,
-                   out,
-                   tied,
-                   NULL,
-                   NULL,
-                   frame_of,
-                   NULL,
-                   FRAME_SPACE_SKIP * spacing,
-                   {0},
-                   {0}};
-  cloud_box(xyz, n, job.lo, job.hi);
+  frame_job job = {
+      xyz, axes, out, tied, NULL, NULL, frame_of, NULL, FRAME_SPACE_SKIP * spacing};
   if (st == DACPO_OK)
     st = dacpo_parallel_for(
         out->count, num_threads, frame_window_task, &job, NULL, DACPO_STAGE_ILP, err);
